@@ -10,6 +10,19 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
+    /// Provisional constructor (replaced by the loader module).
+    pub fn new(vertices: Vec<[f64; 3]>, faces: Vec<[u32; 3]>) -> Result<TriMesh, String> {
+        if vertices.is_empty()
+            || faces.is_empty()
+            || faces
+                .iter()
+                .flatten()
+                .any(|&i| i as usize >= vertices.len())
+        {
+            return Err("bad mesh".into());
+        }
+        Ok(TriMesh { vertices, faces })
+    }
     /// The vertex positions, in model units.
     pub fn vertices(&self) -> &[[f64; 3]] {
         &self.vertices
@@ -18,4 +31,17 @@ impl TriMesh {
     pub fn faces(&self) -> &[[u32; 3]] {
         &self.faces
     }
+}
+
+/// Whether a triangle has zero area: its edge cross product is exactly zero in f64
+/// (repeated, coincident or collinear corners). Such triangles are kept: they can touch.
+pub fn triangle_is_degenerate(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    n == [0.0; 3]
 }

@@ -1,0 +1,125 @@
+//! From drafts to the final arrays: choose the encoding from the tree's shape, pack every
+//! reference, and gather the statistics that `info` reads from the header.
+
+use super::topdown::DraftTree;
+use super::{BuildError, BuiltTree};
+use crate::bv::{BoundingVolume, Node};
+use crate::mesh::triangle_is_degenerate;
+use crate::tree::{Encoding, NodeRef};
+
+/// Whole-tree statistics, computed once at build time and stored in the file header so that
+/// `info` never reads the sections.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TreeStats {
+    /// Number of leaf nodes.
+    pub leaves: u32,
+    /// Nodes on the longest root-to-leaf path (a lone root has depth 1).
+    pub depth: u32,
+    /// Most faces in one leaf.
+    pub max_leaf_faces: u32,
+    /// Triangles of zero area as stored (exactly zero cross product of the stored corners).
+    pub degenerate_triangles: u32,
+    /// Componentwise minimum of all stored vertices, model units.
+    pub bounds_min: [f64; 3],
+    /// Componentwise maximum of all stored vertices, model units.
+    pub bounds_max: [f64; 3],
+}
+
+impl TreeStats {
+    /// Statistics of a node array whose children always follow their parent; also says
+    /// whether the tree is binary with single-face leaves. Returns `None` if a reference
+    /// points outside the arrays or backwards.
+    pub(crate) fn of_nodes(
+        refs: impl Iterator<Item = NodeRef>,
+        node_count: usize,
+    ) -> Option<(TreeStats, bool)> {
+        let mut depth = vec![0u32; node_count];
+        let mut stats = TreeStats::default();
+        let mut binary = true;
+        for (i, r) in refs.enumerate() {
+            let d = if i == 0 { 1 } else { *depth.get(i)? };
+            if d == 0 {
+                return None; // never referenced by a parent: not a tree
+            }
+            stats.depth = stats.depth.max(d);
+            match r {
+                NodeRef::Internal { first, count } => {
+                    binary &= count == 2;
+                    let range = r.range();
+                    if first as usize <= i || range.end > node_count as u64 {
+                        return None;
+                    }
+                    for child in range {
+                        let slot = depth.get_mut(child as usize)?;
+                        if *slot != 0 {
+                            return None; // two parents
+                        }
+                        *slot = d + 1;
+                    }
+                    let _ = first;
+                }
+                NodeRef::Leaf { count, .. } => {
+                    binary &= count == 1;
+                    stats.leaves += 1;
+                    stats.max_leaf_faces = stats.max_leaf_faces.max(count);
+                }
+            }
+        }
+        Some((stats, binary))
+    }
+}
+
+pub(crate) fn finish<B: BoundingVolume>(
+    draft: DraftTree<B>,
+    vertices: Vec<[B::Real; 3]>,
+    positions: &[[f64; 3]],
+) -> Result<BuiltTree<B>, BuildError> {
+    let (mut stats, binary) =
+        TreeStats::of_nodes(draft.nodes.iter().map(|d| d.refs), draft.nodes.len())
+            .expect("the builder lays children out after their parent");
+    let encoding = if binary {
+        Encoding::Binary
+    } else {
+        Encoding::Variable
+    };
+    let nodes = draft
+        .nodes
+        .iter()
+        .map(|d| Ok(Node::new(d.bv, encoding.encode(d.refs)?)))
+        .collect::<Result<Vec<_>, BuildError>>()?;
+    stats.degenerate_triangles = draft
+        .faces
+        .iter()
+        .filter(|f| {
+            let corner = |k: usize| positions.get(f[k] as usize).copied().unwrap_or_default();
+            triangle_is_degenerate(corner(0), corner(1), corner(2))
+        })
+        .count() as u32;
+    let (lo, hi) = bounds(positions);
+    stats.bounds_min = lo;
+    stats.bounds_max = hi;
+    Ok(BuiltTree {
+        vertices,
+        faces: draft.faces,
+        source_ids: draft.source_ids,
+        nodes,
+        encoding,
+        stats,
+    })
+}
+
+/// Componentwise extremes of `points` (zeros for none).
+pub(crate) fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    if points.is_empty() {
+        return ([0.0; 3], [0.0; 3]);
+    }
+    (lo, hi)
+}

@@ -1,0 +1,135 @@
+//! The offline builder: a validated mesh in, a finished `.obbt` image out.
+//!
+//! Top-down (dissertation §3.1.1, §7.5.2): fit a frame to a node's triangles, enclose them,
+//! split them by centroid with the plane orthogonal to the frame's axis of greatest spread
+//! through the mean centroid (the median if one side would be empty), and recurse until a
+//! node holds at most `leaf_size` triangles. The split rule ignores the volume type, so OBB,
+//! AABB and sphere trees of one mesh have the same shape and compare on equal footing.
+
+mod layout;
+mod topdown;
+
+pub(crate) use layout::bounds as bounds_of;
+pub use layout::TreeStats;
+
+use crate::bv::{Aabb, BoundingVolume, BvKind, Obb, Sphere};
+use crate::fit::FitMethod;
+use crate::format::{self, ObbtFile};
+use crate::mesh::TriMesh;
+use crate::real::{Precision, Real};
+use crate::tree::{EncodeError, BINARY_MAX_FACE, VARIABLE_MAX_LEAF_FACES};
+use std::sync::atomic::AtomicU64;
+
+/// Everything that decides the shape and contents of a built tree. The same mesh and options
+/// always give a byte-identical file, whatever the number of threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BuildOptions {
+    /// The bounding volume stored in every node.
+    pub bv: BvKind,
+    /// The stored precision of vertices and volumes.
+    pub precision: Precision,
+    /// The covariance the node frames are fitted to.
+    pub fit: FitMethod,
+    /// Largest number of triangles in a leaf, 1 to 128. With 1 the tree is binary with
+    /// single-face leaves and uses the compact binary encoding.
+    pub leaf_size: u32,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            bv: BvKind::Obb,
+            precision: Precision::F32,
+            fit: FitMethod::Hull,
+            leaf_size: 1,
+        }
+    }
+}
+
+/// Why a tree could not be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BuildError {
+    /// `leaf_size` outside 1..=128.
+    #[error("leaf size {0} is out of range (1 to {VARIABLE_MAX_LEAF_FACES})")]
+    LeafSize(u32),
+    /// The mesh is too large for the 32-bit references of the file format.
+    #[error("the mesh is too large for the .obbt format: {0}")]
+    TooLarge(#[from] EncodeError),
+    /// More triangles or vertices than a 32-bit count holds.
+    #[error("the mesh has {count} {what}; the .obbt format holds at most {max}")]
+    TooManyElements {
+        /// "triangles" or "vertices".
+        what: &'static str,
+        /// The count found.
+        count: usize,
+        /// The largest count the format holds.
+        max: u64,
+    },
+}
+
+/// Builds the tree of `mesh` and lays it out as a complete `.obbt` image in memory (the same
+/// bytes [`ObbtFile::write_atomic`] puts on disk).
+///
+/// `progress`, when given, is advanced by the number of triangles placed in leaves, up to
+/// `mesh.faces().len()`; another thread may poll it.
+pub fn build(
+    mesh: &TriMesh,
+    options: &BuildOptions,
+    progress: Option<&AtomicU64>,
+) -> Result<ObbtFile, BuildError> {
+    match (options.bv, options.precision) {
+        (BvKind::Obb, Precision::F32) => build_as::<Obb<f32>>(mesh, options, progress),
+        (BvKind::Obb, Precision::F64) => build_as::<Obb<f64>>(mesh, options, progress),
+        (BvKind::Aabb, Precision::F32) => build_as::<Aabb<f32>>(mesh, options, progress),
+        (BvKind::Aabb, Precision::F64) => build_as::<Aabb<f64>>(mesh, options, progress),
+        (BvKind::Sphere, Precision::F32) => build_as::<Sphere<f32>>(mesh, options, progress),
+        (BvKind::Sphere, Precision::F64) => build_as::<Sphere<f64>>(mesh, options, progress),
+    }
+}
+
+fn build_as<B: BoundingVolume>(
+    mesh: &TriMesh,
+    options: &BuildOptions,
+    progress: Option<&AtomicU64>,
+) -> Result<ObbtFile, BuildError> {
+    if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&options.leaf_size) {
+        return Err(BuildError::LeafSize(options.leaf_size));
+    }
+    // Face indices must fit a binary leaf (a non-negative i32); vertex ids a u32.
+    let limits = [
+        (
+            "triangles",
+            mesh.faces().len(),
+            u64::from(BINARY_MAX_FACE) + 1,
+        ),
+        ("vertices", mesh.vertices().len(), u64::from(u32::MAX)),
+    ];
+    for (what, count, max) in limits {
+        if count as u64 > max {
+            return Err(BuildError::TooManyElements { what, count, max });
+        }
+    }
+    // Everything downstream sees the vertices exactly as stored, so the volumes contain the
+    // stored (possibly f32-rounded) triangles, not the input ones.
+    let stored: Vec<[B::Real; 3]> = mesh
+        .vertices()
+        .iter()
+        .map(|p| p.map(<B::Real as Real>::from_f64_nearest))
+        .collect();
+    let positions: Vec<[f64; 3]> = stored.iter().map(crate::real::point_to_f64).collect();
+    let draft = topdown::build_drafts::<B>(&positions, mesh.faces(), options, progress);
+    let tree = layout::finish(draft, stored, &positions)?;
+    Ok(format::serialize(&tree, options))
+}
+
+/// A finished tree in memory: the arrays of the file, before serialization.
+#[derive(Debug)]
+pub(crate) struct BuiltTree<B: BoundingVolume> {
+    pub vertices: Vec<[B::Real; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    pub source_ids: Vec<u32>,
+    pub nodes: Vec<crate::bv::Node<B>>,
+    pub encoding: crate::tree::Encoding,
+    pub stats: TreeStats,
+}

@@ -1,0 +1,83 @@
+//! Axis-aligned bounding box in the model frame.
+
+use super::obb::box_measures;
+use super::{all_finite, face_vertices, BoundingVolume, BvDefect, BvKind};
+use crate::real::{point_to_f64, Real};
+use nalgebra::Matrix3;
+use zerocopy::{FromBytes, Immutable, KnownLayout};
+
+/// The box `min <= p <= max` (componentwise) in the model frame.
+///
+/// # Memory Layout
+///
+/// `#[repr(C)]`, 6 scalars: `min` then `max`. 24 bytes in f32, 48 in f64.
+#[derive(Clone, Copy, Debug, PartialEq, FromBytes, KnownLayout, Immutable)]
+#[repr(C)]
+pub struct Aabb<R> {
+    /// Smallest coordinates, model units.
+    pub min: [R; 3],
+    /// Largest coordinates, model units; `max >= min` componentwise.
+    pub max: [R; 3],
+}
+
+impl<R: Real> Aabb<R> {
+    fn half_f64(&self) -> [f64; 3] {
+        std::array::from_fn(|i| 0.5 * (self.max[i].to_f64() - self.min[i].to_f64()))
+    }
+}
+
+impl<R: Real> BoundingVolume for Aabb<R> {
+    type Real = R;
+    const KIND: BvKind = BvKind::Aabb;
+
+    fn enclose(_frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in face_vertices(positions, faces) {
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        if !lo[0].is_finite() {
+            lo = [0.0; 3];
+            hi = [0.0; 3];
+        }
+        // Directed rounding keeps the box conservative in f32; comparisons are exact.
+        Aabb {
+            min: lo.map(R::from_f64_down),
+            max: hi.map(R::from_f64_up),
+        }
+    }
+
+    fn write_le(&self, out: &mut Vec<u8>) {
+        for v in self.min.iter().chain(&self.max) {
+            v.write_le(out);
+        }
+    }
+
+    fn validate(&self) -> Result<(), BvDefect> {
+        if !all_finite(&self.min) || !all_finite(&self.max) {
+            return Err(BvDefect::NotFinite);
+        }
+        if (0..3).any(|i| self.max[i].to_f64() < self.min[i].to_f64()) {
+            return Err(BvDefect::NegativeExtent);
+        }
+        Ok(())
+    }
+
+    fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
+        let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
+        (0..3).all(|i| p[i] >= lo[i] - tolerance && p[i] <= hi[i] + tolerance)
+    }
+
+    fn diameter(&self) -> f64 {
+        box_measures(self.half_f64()).0
+    }
+    fn volume(&self) -> f64 {
+        box_measures(self.half_f64()).1
+    }
+    fn surface_area(&self) -> f64 {
+        box_measures(self.half_f64()).2
+    }
+}

@@ -1,0 +1,200 @@
+//! Bounding volumes: the trait every tree node's volume implements, and the node record.
+//!
+//! Three volumes exist so the dissertation's comparisons can run on equal footing: the
+//! oriented box ([`Obb`], the default), the axis-aligned box ([`Aabb`]) and the sphere
+//! ([`Sphere`]). The builder splits every tree with the same rule whatever the volume, so
+//! trees of different volume types over the same mesh have the same shape.
+
+mod aabb;
+mod obb;
+mod sphere;
+
+pub use aabb::Aabb;
+pub use obb::Obb;
+pub use sphere::Sphere;
+
+use crate::real::Real;
+use nalgebra::Matrix3;
+use std::fmt::Debug;
+use zerocopy::{FromBytes, Immutable, KnownLayout};
+
+/// Which bounding volume a tree stores, as written in the file header.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BvKind {
+    /// Oriented bounding box, fitted to a covariance frame.
+    #[default]
+    Obb,
+    /// Axis-aligned bounding box in the model frame.
+    Aabb,
+    /// Bounding sphere, centred on the box centre of the fitted frame.
+    Sphere,
+}
+
+impl BvKind {
+    /// All kinds, default first.
+    pub const ALL: [BvKind; 3] = [BvKind::Obb, BvKind::Aabb, BvKind::Sphere];
+
+    /// The header tag (1, 2, 3).
+    pub fn tag(self) -> u8 {
+        match self {
+            BvKind::Obb => 1,
+            BvKind::Aabb => 2,
+            BvKind::Sphere => 3,
+        }
+    }
+
+    /// Inverse of [`BvKind::tag`].
+    pub fn from_tag(tag: u8) -> Option<BvKind> {
+        BvKind::ALL.into_iter().find(|k| k.tag() == tag)
+    }
+
+    /// `"obb"`, `"aabb"` or `"sphere"`, as used by the CLI.
+    pub fn name(self) -> &'static str {
+        match self {
+            BvKind::Obb => "obb",
+            BvKind::Aabb => "aabb",
+            BvKind::Sphere => "sphere",
+        }
+    }
+
+    /// Inverse of [`BvKind::name`].
+    pub fn from_name(name: &str) -> Option<BvKind> {
+        BvKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// Why a stored volume is not well formed (found by `verify`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BvDefect {
+    /// A component is NaN or infinite.
+    NotFinite,
+    /// A half-width, radius, or `max - min` is negative.
+    NegativeExtent,
+    /// The stored axes are not orthonormal within the precision's tolerance.
+    AxesNotOrthonormal,
+}
+
+impl std::fmt::Display for BvDefect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            BvDefect::NotFinite => "a bounding-volume component is not finite",
+            BvDefect::NegativeExtent => "a bounding-volume extent is negative",
+            BvDefect::AxesNotOrthonormal => "the box axes are not orthonormal",
+        })
+    }
+}
+
+/// A bounding volume as stored in a tree node, in the model frame of its tree.
+///
+/// Implementations are `#[repr(C)]` plain data read zero-copy from mapped files, so any bit
+/// pattern is a value: [`BoundingVolume::validate`] says whether it is a well-formed one.
+pub trait BoundingVolume:
+    Copy + Debug + Send + Sync + 'static + FromBytes + KnownLayout + Immutable
+{
+    /// The stored scalar type.
+    type Real: Real;
+    /// The header tag of this volume type.
+    const KIND: BvKind;
+
+    /// The smallest volume of this type that contains every vertex of `faces`, given the
+    /// fitted frame `axes` (orthonormal columns, greatest spread first; only the oriented box
+    /// and the sphere use it). `positions` are the stored vertices widened to f64, so the
+    /// result contains them exactly: every rounding to [`Self::Real`] is outward.
+    fn enclose(axes: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self;
+
+    /// Appends the little-endian bytes of this volume in on-disk field order.
+    fn write_le(&self, out: &mut Vec<u8>);
+
+    /// Checks the invariants a reader cannot assume of foreign bytes.
+    fn validate(&self) -> Result<(), BvDefect>;
+
+    /// Whether model-frame point `p` lies inside, allowing `tolerance` model units of slack.
+    fn contains(&self, p: [f64; 3], tolerance: f64) -> bool;
+
+    /// Largest distance between two points of the volume (model units).
+    fn diameter(&self) -> f64;
+    /// Enclosed volume (cubic model units).
+    fn volume(&self) -> f64;
+    /// Surface area (square model units).
+    fn surface_area(&self) -> f64;
+}
+
+/// One tree node as stored in the `nodes` section: a bounding volume and one packed 32-bit
+/// reference to its children or faces (decoded only by [`crate::tree`]).
+///
+/// # Memory Layout
+///
+/// `#[repr(C)]`: the volume's fields, then `packed` (u32, little-endian), then zero padding up
+/// to the scalar alignment (none for f32, 4 bytes for f64). Sizes: OBB 64 / 128 bytes (an f32
+/// node is one cache line), AABB 28 / 56, sphere 20 / 40 (f32 / f64).
+#[derive(Clone, Copy, Debug, FromBytes, KnownLayout, Immutable)]
+#[repr(C)]
+pub struct Node<B: BoundingVolume> {
+    /// The volume enclosing every vertex of every face below this node.
+    pub bv: B,
+    /// Packed child or face reference; see [`crate::tree::Encoding`].
+    pub packed: u32,
+    /// Zero padding to the scalar alignment.
+    pad: <B::Real as Real>::NodePad,
+}
+
+impl<B: BoundingVolume> Node<B> {
+    /// A node record from its volume and packed reference.
+    pub fn new(bv: B, packed: u32) -> Self {
+        Node {
+            bv,
+            packed,
+            pad: Default::default(),
+        }
+    }
+
+    /// The on-disk size of one node of this type, in bytes.
+    pub const SIZE: usize = std::mem::size_of::<Self>();
+
+    /// Appends the little-endian bytes of this node, padding included (zero).
+    pub fn write_le(&self, out: &mut Vec<u8>) {
+        let start = out.len();
+        self.bv.write_le(out);
+        out.extend_from_slice(&self.packed.to_le_bytes());
+        out.resize(start + Self::SIZE, 0);
+    }
+}
+
+// The on-disk strides promised by the format spec (formats/obbt.md).
+const _: () = {
+    use std::mem::size_of;
+    assert!(size_of::<Node<Obb<f32>>>() == 64);
+    assert!(size_of::<Node<Obb<f64>>>() == 128);
+    assert!(size_of::<Node<Aabb<f32>>>() == 28);
+    assert!(size_of::<Node<Aabb<f64>>>() == 56);
+    assert!(size_of::<Node<Sphere<f32>>>() == 20);
+    assert!(size_of::<Node<Sphere<f64>>>() == 40);
+};
+
+/// The error bound of `dot(axis, p)` in f64 for axis components of magnitude at most 1:
+/// a few units in the last place of `sum |p_j|`. Added to stored extents so containment
+/// survives the rounding of the projections themselves.
+pub(crate) fn projection_slack(l1_norm: f64) -> f64 {
+    4.0 * f64::EPSILON * l1_norm
+}
+
+/// Sum of absolute coordinates.
+pub(crate) fn l1(p: &[f64; 3]) -> f64 {
+    p[0].abs() + p[1].abs() + p[2].abs()
+}
+
+/// Every distinct-or-not vertex of `faces`, widened; the callers only take extrema over them.
+pub(crate) fn face_vertices<'a>(
+    positions: &'a [[f64; 3]],
+    faces: &'a [[u32; 3]],
+) -> impl Iterator<Item = &'a [f64; 3]> + 'a {
+    faces
+        .iter()
+        .flatten()
+        .filter_map(move |&v| positions.get(v as usize))
+}
+
+/// Whether all components are finite.
+pub(crate) fn all_finite<R: Real>(values: &[R]) -> bool {
+    values.iter().all(|v| v.to_f64().is_finite())
+}

@@ -1,0 +1,94 @@
+//! Bounding sphere.
+
+use super::obb::dot;
+use super::{all_finite, face_vertices, l1, projection_slack, BoundingVolume, BvDefect, BvKind};
+use crate::real::{point_to_f64, Real};
+use nalgebra::Matrix3;
+use zerocopy::{FromBytes, Immutable, KnownLayout};
+
+/// The ball `|p - center| <= radius` in the model frame.
+///
+/// # Memory Layout
+///
+/// `#[repr(C)]`, 4 scalars: `center` then `radius`. 16 bytes in f32, 32 in f64.
+#[derive(Clone, Copy, Debug, PartialEq, FromBytes, KnownLayout, Immutable)]
+#[repr(C)]
+pub struct Sphere<R> {
+    /// Centre, model frame.
+    pub center: [R; 3],
+    /// Radius, non-negative, model units.
+    pub radius: R,
+}
+
+impl<R: Real> BoundingVolume for Sphere<R> {
+    type Real = R;
+    const KIND: BvKind = BvKind::Sphere;
+
+    /// Centred on the middle of the vertices' extents along the fitted axes (the centre of
+    /// the OBB of the same frame), which for elongated sets is far tighter than the
+    /// centroid; the radius is the largest distance from that centre.
+    fn enclose(frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
+        let axes: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| frame[(j, i)]));
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in face_vertices(positions, faces) {
+            for i in 0..3 {
+                let d = dot(&axes[i], p);
+                lo[i] = lo[i].min(d);
+                hi[i] = hi[i].max(d);
+            }
+        }
+        if !lo[0].is_finite() {
+            lo = [0.0; 3];
+            hi = [0.0; 3];
+        }
+        let c: [f64; 3] =
+            std::array::from_fn(|j| (0..3).map(|i| axes[i][j] * 0.5 * (lo[i] + hi[i])).sum());
+        let center = c.map(R::from_f64_nearest);
+        let c = point_to_f64(&center);
+        let mut r2 = 0.0f64;
+        let mut l1_max = 0.0f64;
+        for p in face_vertices(positions, faces) {
+            let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+            r2 = r2.max(dot(&d, &d));
+            l1_max = l1_max.max(l1(p));
+        }
+        let slack = 2.0 * projection_slack(l1_max + l1(&c));
+        Sphere {
+            center,
+            radius: R::from_f64_up(r2.sqrt() + slack),
+        }
+    }
+
+    fn write_le(&self, out: &mut Vec<u8>) {
+        for v in self.center.iter().chain([&self.radius]) {
+            v.write_le(out);
+        }
+    }
+
+    fn validate(&self) -> Result<(), BvDefect> {
+        if !all_finite(&self.center) || !self.radius.to_f64().is_finite() {
+            return Err(BvDefect::NotFinite);
+        }
+        if self.radius.to_f64() < 0.0 {
+            return Err(BvDefect::NegativeExtent);
+        }
+        Ok(())
+    }
+
+    fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
+        let c = point_to_f64(&self.center);
+        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        dot(&d, &d).sqrt() <= self.radius.to_f64() + tolerance
+    }
+
+    fn diameter(&self) -> f64 {
+        2.0 * self.radius.to_f64()
+    }
+    fn volume(&self) -> f64 {
+        4.0 / 3.0 * std::f64::consts::PI * self.radius.to_f64().powi(3)
+    }
+    fn surface_area(&self) -> f64 {
+        4.0 * std::f64::consts::PI * self.radius.to_f64().powi(2)
+    }
+}

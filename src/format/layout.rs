@@ -1,0 +1,182 @@
+//! On-disk structures of `.obbt` files, exactly as `formats/obbt.md` specifies them.
+//!
+//! All integers and floats are little-endian. The header and directory use zerocopy's
+//! byte-order types (alignment 1), so they can be read from any offset on any host; the
+//! sections are read zero-copy as native types, which is why big-endian hosts are refused.
+
+use zerocopy::byteorder::little_endian::{F64, U16, U32, U64};
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
+
+/// The first 8 bytes of every file: a high byte (catches 7-bit transfers), the name, CR LF
+/// (catches line-ending conversion), ^Z (stops `type` on DOS) and LF, as in PNG.
+pub const SIGNATURE: [u8; 8] = [0x89, b'O', b'B', b'T', b'\r', b'\n', 0x1a, b'\n'];
+/// Major version written and read: a reader refuses any other major version.
+pub const VERSION_MAJOR: u16 = 1;
+/// Minor version written: readers accept any minor version of their major version.
+pub const VERSION_MINOR: u16 = 0;
+/// Every section starts at a multiple of this many bytes (a cache line), and the file length
+/// is a multiple of it too.
+pub const SECTION_ALIGN: u64 = 64;
+/// Size of the fixed header, bytes.
+pub const HEADER_SIZE: usize = 128;
+/// Size of one directory entry, bytes.
+pub const ENTRY_SIZE: usize = 40;
+/// Byte offset of the header CRC field.
+pub const HEADER_CRC_OFFSET: usize = 124;
+/// Cap on the number of directory entries, checked before the directory is read.
+pub const MAX_SECTIONS: u16 = 16;
+/// Directory flag: a reader that does not know this section's kind must refuse the file.
+pub const FLAG_REQUIRED: u32 = 1;
+
+/// The fixed 128-byte header at offset 0.
+///
+/// # Memory Layout
+///
+/// `#[repr(C)]`, alignment 1, 128 bytes; offsets are listed in `formats/obbt.md` § Header.
+/// `header_crc` is the CRC-32 (IEEE) of bytes `0..124` followed by the whole directory.
+#[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+#[repr(C)]
+pub struct Header {
+    /// [`SIGNATURE`].
+    pub signature: [u8; 8],
+    /// [`VERSION_MAJOR`].
+    pub version_major: U16,
+    /// [`VERSION_MINOR`].
+    pub version_minor: U16,
+    /// Bytes of header plus directory: `128 + 40 * section_count`.
+    pub header_bytes: U32,
+    /// Total file length in bytes; must equal the actual length.
+    pub file_bytes: U64,
+    /// Bounding volume tag: 1 OBB, 2 AABB, 3 sphere.
+    pub bv_kind: u8,
+    /// Stored scalar size: 4 (f32) or 8 (f64).
+    pub precision: u8,
+    /// Packed reference encoding: 1 binary, 2 variable branching.
+    pub encoding: u8,
+    /// Fit method tag: 1 hull, 2 triangles, 3 vertices.
+    pub fit_method: u8,
+    /// Leaf size the tree was built with (1 to 128).
+    pub leaf_size: U16,
+    /// Number of directory entries (1 to [`MAX_SECTIONS`]).
+    pub section_count: U16,
+    /// Number of triangles (faces), at least 1.
+    pub triangles: U32,
+    /// Number of vertices, at least 1.
+    pub vertices: U32,
+    /// Number of nodes, at least 1.
+    pub nodes: U32,
+    /// Number of leaf nodes.
+    pub leaves: U32,
+    /// Nodes on the longest root-to-leaf path.
+    pub depth: U32,
+    /// Zero-area triangles as stored.
+    pub degenerate_triangles: U32,
+    /// Most faces in one leaf.
+    pub max_leaf_faces: U32,
+    /// Zero.
+    pub reserved0: U32,
+    /// Componentwise minimum of the stored vertices.
+    pub bounds_min: [F64; 3],
+    /// Componentwise maximum of the stored vertices.
+    pub bounds_max: [F64; 3],
+    /// Zero.
+    pub reserved1: [u8; 12],
+    /// CRC-32 of bytes `0..124` and the directory.
+    pub header_crc: U32,
+}
+
+/// One directory entry; the directory follows the header immediately.
+///
+/// # Memory Layout
+///
+/// `#[repr(C)]`, alignment 1, 40 bytes: kind, flags, offset, length, count, stride, crc32.
+#[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+#[repr(C)]
+pub struct SectionEntry {
+    /// What the section holds; see [`SectionKind`].
+    pub kind: U32,
+    /// Bit 0: [`FLAG_REQUIRED`]; other bits zero.
+    pub flags: U32,
+    /// Byte offset from the start of the file, a multiple of [`SECTION_ALIGN`].
+    pub offset: U64,
+    /// Byte length: `count * stride`.
+    pub length: U64,
+    /// Number of records.
+    pub count: U64,
+    /// Bytes per record.
+    pub stride: U32,
+    /// CRC-32 (IEEE) of the section's `length` bytes.
+    pub crc32: U32,
+}
+
+const _: () = {
+    assert!(std::mem::size_of::<Header>() == HEADER_SIZE);
+    assert!(std::mem::size_of::<SectionEntry>() == ENTRY_SIZE);
+    assert!(std::mem::offset_of!(Header, header_crc) == HEADER_CRC_OFFSET);
+};
+
+/// The section kinds this version defines; all four are required.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SectionKind {
+    /// Vertex positions: `[R; 3]` per vertex.
+    Vertices,
+    /// Triangles in leaf order: `[u32; 3]` vertex indices.
+    Faces,
+    /// Input-mesh triangle id of each leaf-ordered face: `u32`.
+    SourceIds,
+    /// Tree nodes: volume + packed reference (see `bv::Node`).
+    Nodes,
+}
+
+impl SectionKind {
+    /// The kinds in the order the writer lays them out.
+    pub const ALL: [SectionKind; 4] = [
+        SectionKind::Vertices,
+        SectionKind::Faces,
+        SectionKind::SourceIds,
+        SectionKind::Nodes,
+    ];
+
+    /// The directory tag.
+    pub fn tag(self) -> u32 {
+        match self {
+            SectionKind::Vertices => 1,
+            SectionKind::Faces => 2,
+            SectionKind::SourceIds => 3,
+            SectionKind::Nodes => 4,
+        }
+    }
+
+    /// Inverse of [`SectionKind::tag`]; `None` for kinds this reader does not know.
+    pub fn from_tag(tag: u32) -> Option<SectionKind> {
+        SectionKind::ALL.into_iter().find(|k| k.tag() == tag)
+    }
+
+    /// The name used in messages and `info`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SectionKind::Vertices => "vertices",
+            SectionKind::Faces => "faces",
+            SectionKind::SourceIds => "source_ids",
+            SectionKind::Nodes => "nodes",
+        }
+    }
+}
+
+/// Rounds `n` up to the next multiple of [`SECTION_ALIGN`], or `None` on overflow.
+pub fn align_up(n: u64) -> Option<u64> {
+    n.checked_add(SECTION_ALIGN - 1)
+        .map(|m| m / SECTION_ALIGN * SECTION_ALIGN)
+}
+
+/// CRC-32 of the header (without its CRC field) followed by the directory.
+pub fn header_crc(header_bytes: &[u8], directory: &[u8]) -> u32 {
+    let mut h = crc32fast::Hasher::new();
+    h.update(
+        header_bytes
+            .get(..HEADER_CRC_OFFSET)
+            .unwrap_or(header_bytes),
+    );
+    h.update(directory);
+    h.finalize()
+}

@@ -1,0 +1,20 @@
+//! The `.obbt` file: writing, opening (O(1), memory-mapped), typed views and verification.
+//!
+//! `formats/obbt.md` is the specification; this module follows it. The split of checks is
+//! the one the spec prescribes: [`ObbtFile::open`] and [`ObbtFile::from_aligned`] check the
+//! header and section directory only (constant time, whatever the file size); the O(n)
+//! checks live in [`ObbtFile::verify`]. Queries on an unverified file use checked access, so
+//! a corrupt file gives an error or a wrong-but-safe answer, never undefined behaviour.
+
+mod aligned;
+mod error;
+pub mod layout;
+mod open;
+mod verify;
+mod write;
+
+pub use aligned::AlignedBytes;
+pub use error::{FormatError, OpenError, VerifyError};
+pub use open::{Info, ObbtFile, SectionInfo, TreeVisitor};
+pub(crate) use write::serialize;
+pub use write::write_atomic;

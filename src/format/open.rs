@@ -1,0 +1,532 @@
+//! Opening a `.obbt` image: the O(1) header and directory checks, and typed views.
+
+use super::aligned::AlignedBytes;
+use super::error::{FormatError, OpenError, VerifyError};
+use super::layout::{
+    align_up, header_crc, Header, SectionEntry, SectionKind, ENTRY_SIZE, FLAG_REQUIRED,
+    HEADER_SIZE, MAX_SECTIONS, SECTION_ALIGN, SIGNATURE, VERSION_MAJOR,
+};
+use crate::bv::{Aabb, BoundingVolume, BvKind, Node, Obb, Sphere};
+use crate::fit::FitMethod;
+use crate::real::{Precision, Real};
+use crate::tree::{Encoding, TreeView, VARIABLE_MAX_LEAF_FACES};
+use std::ops::Range;
+use std::path::Path;
+use zerocopy::FromBytes;
+
+/// Where the bytes live. Both are 64-byte aligned and immutable for the file's lifetime.
+enum Backing {
+    Mapped(memmap2::Mmap),
+    Owned(AlignedBytes),
+}
+
+/// An opened `.obbt` tree: a memory-mapped file or an in-memory image, with its header and
+/// directory checked. Cheap to open whatever the size; `Send + Sync`, so one file can serve
+/// queries on many threads.
+pub struct ObbtFile {
+    backing: Backing,
+    header: Header,
+    sections: Vec<SectionInfo>,
+    /// Byte ranges of the four required sections, in [`SectionKind::ALL`] order.
+    required: [Range<usize>; 4],
+    bv: BvKind,
+    precision: Precision,
+    encoding: Encoding,
+    fit: FitMethod,
+}
+
+impl std::fmt::Debug for ObbtFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ObbtFile")
+            .field("info", &self.info())
+            .finish()
+    }
+}
+
+/// One directory entry, decoded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SectionInfo {
+    /// The kind tag as stored.
+    pub kind_tag: u32,
+    /// The kind, if this reader knows it.
+    pub kind: Option<SectionKind>,
+    /// Directory flags.
+    pub flags: u32,
+    /// Byte offset in the file.
+    pub offset: u64,
+    /// Byte length.
+    pub length: u64,
+    /// Record count.
+    pub count: u64,
+    /// Bytes per record.
+    pub stride: u32,
+    /// Stored CRC-32 of the section bytes.
+    pub crc32: u32,
+}
+
+impl SectionInfo {
+    /// The section's name: the kind's name, or `kind N` for an unknown optional kind.
+    pub fn name(&self) -> String {
+        match self.kind {
+            Some(k) => k.name().to_string(),
+            None => format!("kind {}", self.kind_tag),
+        }
+    }
+}
+
+/// Everything the header says about a tree; reading it touches no section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Info {
+    /// Format version (major, minor).
+    pub version: (u16, u16),
+    /// Bounding volume type.
+    pub bv: BvKind,
+    /// Stored precision.
+    pub precision: Precision,
+    /// Fit method the tree was built with.
+    pub fit: FitMethod,
+    /// Packed reference encoding.
+    pub encoding: Encoding,
+    /// Leaf size the tree was built with.
+    pub leaf_size: u32,
+    /// Triangle count.
+    pub triangles: u32,
+    /// Vertex count.
+    pub vertices: u32,
+    /// Node count.
+    pub nodes: u32,
+    /// Leaf count.
+    pub leaves: u32,
+    /// Nodes on the longest root-to-leaf path.
+    pub depth: u32,
+    /// Most faces in one leaf.
+    pub max_leaf_faces: u32,
+    /// Zero-area triangles as stored.
+    pub degenerate_triangles: u32,
+    /// Componentwise minimum of the vertices (model units).
+    pub bounds_min: [f64; 3],
+    /// Componentwise maximum of the vertices (model units).
+    pub bounds_max: [f64; 3],
+    /// File length in bytes.
+    pub file_bytes: u64,
+    /// The section directory.
+    pub sections: Vec<SectionInfo>,
+}
+
+/// Code generic over the volume type, run once on the concrete view of a file (static
+/// dispatch: the match on the header tags happens once, not per node).
+pub trait TreeVisitor {
+    /// What the visit returns.
+    type Output;
+    /// Called with the file's tree, whatever its volume type and precision.
+    fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output;
+}
+
+/// The stride of one node record of a given volume and precision.
+pub(crate) fn node_size(bv: BvKind, precision: Precision) -> usize {
+    match (bv, precision) {
+        (BvKind::Obb, Precision::F32) => Node::<Obb<f32>>::SIZE,
+        (BvKind::Obb, Precision::F64) => Node::<Obb<f64>>::SIZE,
+        (BvKind::Aabb, Precision::F32) => Node::<Aabb<f32>>::SIZE,
+        (BvKind::Aabb, Precision::F64) => Node::<Aabb<f64>>::SIZE,
+        (BvKind::Sphere, Precision::F32) => Node::<Sphere<f32>>::SIZE,
+        (BvKind::Sphere, Precision::F64) => Node::<Sphere<f64>>::SIZE,
+    }
+}
+
+fn field(field: &'static str, offset: usize, problem: impl Into<String>) -> FormatError {
+    FormatError::HeaderField {
+        field,
+        offset,
+        problem: problem.into(),
+    }
+}
+
+impl ObbtFile {
+    /// Memory-maps `path` and checks its header and directory (O(1) in the file size).
+    ///
+    /// This is the one place obbtree maps files. The map is read-only and private to this
+    /// value; every later read goes through checked slices of it.
+    pub fn open(path: impl AsRef<Path>) -> Result<ObbtFile, OpenError> {
+        let path = path.as_ref();
+        let io = |source| OpenError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = std::fs::File::open(path).map_err(io)?;
+        let len = file.metadata().map_err(io)?.len();
+        // Mapping an empty file fails on some systems; an empty buffer gets the clearer
+        // "truncated" error from the header checks instead.
+        let backing = if len == 0 {
+            Backing::Owned(AlignedBytes::zeroed(0))
+        } else {
+            // SAFETY: the map is read-only and never handed out mutably. Undefined behaviour
+            // is possible only if another process truncates or rewrites the file while it is
+            // mapped; obbtree never does (it writes through a temporary file and an atomic
+            // rename, which leaves existing maps intact), and this is the documented contract
+            // of opening a file: do not modify it in place while it is open.
+            let map = unsafe { memmap2::Mmap::map(&file) }.map_err(io)?;
+            Backing::Mapped(map)
+        };
+        ObbtFile::from_backing(backing).map_err(|source| OpenError::Format {
+            path: path.to_path_buf(),
+            source,
+        })
+    }
+
+    /// Takes an in-memory image (for example a copy of an embedded asset) and checks its
+    /// header and directory (O(1)).
+    pub fn from_aligned(bytes: AlignedBytes) -> Result<ObbtFile, FormatError> {
+        ObbtFile::from_backing(Backing::Owned(bytes))
+    }
+
+    /// All bytes of the image.
+    pub fn bytes(&self) -> &[u8] {
+        match &self.backing {
+            Backing::Mapped(m) => m,
+            Backing::Owned(b) => b.as_bytes(),
+        }
+    }
+
+    /// The raw header.
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// The decoded section directory.
+    pub fn sections(&self) -> &[SectionInfo] {
+        &self.sections
+    }
+
+    /// The volume type stored.
+    pub fn bv_kind(&self) -> BvKind {
+        self.bv
+    }
+
+    /// The stored precision.
+    pub fn precision(&self) -> Precision {
+        self.precision
+    }
+
+    /// What the header says about the tree (reads no section).
+    pub fn info(&self) -> Info {
+        let h = &self.header;
+        Info {
+            version: (h.version_major.get(), h.version_minor.get()),
+            bv: self.bv,
+            precision: self.precision,
+            fit: self.fit,
+            encoding: self.encoding,
+            leaf_size: u32::from(h.leaf_size.get()),
+            triangles: h.triangles.get(),
+            vertices: h.vertices.get(),
+            nodes: h.nodes.get(),
+            leaves: h.leaves.get(),
+            depth: h.depth.get(),
+            max_leaf_faces: h.max_leaf_faces.get(),
+            degenerate_triangles: h.degenerate_triangles.get(),
+            bounds_min: h.bounds_min.map(|v| v.get()),
+            bounds_max: h.bounds_max.map(|v| v.get()),
+            file_bytes: h.file_bytes.get(),
+            sections: self.sections.clone(),
+        }
+    }
+
+    /// The O(n) checks of the spec: section checksums, zero padding, indices in bounds, a
+    /// well-formed tree, finite values, and every volume containing the vertices below it.
+    pub fn verify(&self) -> Result<(), VerifyError> {
+        super::verify::verify(self)
+    }
+
+    /// Writes the image to `path` atomically (temporary file in the same directory, fsync,
+    /// rename): readers see the old file or the new one, never a partial one.
+    pub fn write_atomic(&self, path: impl AsRef<Path>) -> std::io::Result<()> {
+        super::write::write_atomic(path.as_ref(), self.bytes())
+    }
+
+    /// The tree typed as volume `B`; an error if the file stores another type or precision.
+    pub fn view<B: BoundingVolume>(&self) -> Result<TreeView<'_, B>, FormatError> {
+        if B::KIND != self.bv || <B::Real as Real>::PRECISION != self.precision {
+            return Err(FormatError::WrongType {
+                found: format!("{} {}", self.bv.name(), self.precision.name()),
+                requested: format!("{} {}", B::KIND.name(), <B::Real as Real>::PRECISION.name()),
+            });
+        }
+        let bytes = self.bytes();
+        let section = |k: usize| {
+            let kind = SectionKind::ALL[k];
+            let range = self.required[k].clone();
+            let problem = |p: &str| FormatError::Section {
+                index: k,
+                kind: kind.name().into(),
+                problem: p.into(),
+            };
+            bytes.get(range).ok_or_else(|| problem("out of bounds"))
+        };
+        let cast_err = |k: usize| FormatError::Section {
+            index: k,
+            kind: SectionKind::ALL[k].name().into(),
+            problem: "cannot be viewed as records (misaligned or bad length)".into(),
+        };
+        Ok(TreeView {
+            encoding: self.encoding,
+            vertices: <[[B::Real; 3]]>::ref_from_bytes(section(0)?).map_err(|_| cast_err(0))?,
+            faces: <[[u32; 3]]>::ref_from_bytes(section(1)?).map_err(|_| cast_err(1))?,
+            source_ids: <[u32]>::ref_from_bytes(section(2)?).map_err(|_| cast_err(2))?,
+            nodes: <[Node<B>]>::ref_from_bytes(section(3)?).map_err(|_| cast_err(3))?,
+        })
+    }
+
+    /// Runs `visitor` on the tree with its concrete volume type and precision.
+    pub fn visit<V: TreeVisitor>(&self, visitor: V) -> Result<V::Output, FormatError> {
+        Ok(match (self.bv, self.precision) {
+            (BvKind::Obb, Precision::F32) => visitor.visit(self.view::<Obb<f32>>()?),
+            (BvKind::Obb, Precision::F64) => visitor.visit(self.view::<Obb<f64>>()?),
+            (BvKind::Aabb, Precision::F32) => visitor.visit(self.view::<Aabb<f32>>()?),
+            (BvKind::Aabb, Precision::F64) => visitor.visit(self.view::<Aabb<f64>>()?),
+            (BvKind::Sphere, Precision::F32) => visitor.visit(self.view::<Sphere<f32>>()?),
+            (BvKind::Sphere, Precision::F64) => visitor.visit(self.view::<Sphere<f64>>()?),
+        })
+    }
+
+    fn from_backing(backing: Backing) -> Result<ObbtFile, FormatError> {
+        if cfg!(target_endian = "big") {
+            return Err(FormatError::BigEndianHost);
+        }
+        let bytes: &[u8] = match &backing {
+            Backing::Mapped(m) => m,
+            Backing::Owned(b) => b.as_bytes(),
+        };
+        if bytes.as_ptr() as usize % SECTION_ALIGN as usize != 0 {
+            return Err(FormatError::Misaligned);
+        }
+        let checked = check_header(bytes)?;
+        Ok(ObbtFile {
+            backing,
+            header: checked.header,
+            sections: checked.sections,
+            required: checked.required,
+            bv: checked.bv,
+            precision: checked.precision,
+            encoding: checked.encoding,
+            fit: checked.fit,
+        })
+    }
+}
+
+struct Checked {
+    header: Header,
+    sections: Vec<SectionInfo>,
+    required: [Range<usize>; 4],
+    bv: BvKind,
+    precision: Precision,
+    encoding: Encoding,
+    fit: FitMethod,
+}
+
+/// The O(1) checks: signature, version, header CRC, declared length, tags and counts, and a
+/// directory whose sections are in bounds, aligned, disjoint and consistent with the header.
+fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
+    let len = bytes.len() as u64;
+    let too_short = |needed: u64| FormatError::TooShort { len, needed };
+    let head = bytes
+        .get(..HEADER_SIZE)
+        .ok_or(too_short(HEADER_SIZE as u64))?;
+    let header = Header::read_from_bytes(head).map_err(|_| too_short(HEADER_SIZE as u64))?;
+    if header.signature != SIGNATURE {
+        return Err(FormatError::BadSignature);
+    }
+    let (major, minor) = (header.version_major.get(), header.version_minor.get());
+    if major != VERSION_MAJOR {
+        return Err(FormatError::UnsupportedVersion { major, minor });
+    }
+    let count = header.section_count.get();
+    if count == 0 || count > MAX_SECTIONS {
+        return Err(field(
+            "section_count",
+            30,
+            format!("{count} is outside 1..={MAX_SECTIONS}"),
+        ));
+    }
+    let header_bytes = HEADER_SIZE + ENTRY_SIZE * usize::from(count);
+    if header.header_bytes.get() as usize != header_bytes {
+        return Err(field(
+            "header_bytes",
+            12,
+            format!(
+                "{} but {count} sections need {header_bytes}",
+                header.header_bytes.get()
+            ),
+        ));
+    }
+    let directory = bytes
+        .get(HEADER_SIZE..header_bytes)
+        .ok_or(too_short(header_bytes as u64))?;
+    let computed = header_crc(head, directory);
+    if computed != header.header_crc.get() {
+        return Err(FormatError::HeaderChecksum {
+            stored: header.header_crc.get(),
+            computed,
+        });
+    }
+    if header.file_bytes.get() != len {
+        return Err(FormatError::LengthMismatch {
+            declared: header.file_bytes.get(),
+            actual: len,
+        });
+    }
+    let bv = BvKind::from_tag(header.bv_kind)
+        .ok_or_else(|| field("bv_kind", 24, format!("unknown tag {}", header.bv_kind)))?;
+    let precision = Precision::from_tag(header.precision)
+        .ok_or_else(|| field("precision", 25, format!("unknown tag {}", header.precision)))?;
+    let encoding = Encoding::from_tag(header.encoding)
+        .ok_or_else(|| field("encoding", 26, format!("unknown tag {}", header.encoding)))?;
+    let fit = FitMethod::from_tag(header.fit_method).ok_or_else(|| {
+        field(
+            "fit_method",
+            27,
+            format!("unknown tag {}", header.fit_method),
+        )
+    })?;
+    let leaf_size = u32::from(header.leaf_size.get());
+    if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&leaf_size) {
+        return Err(field(
+            "leaf_size",
+            28,
+            format!("{leaf_size} is outside 1..={VARIABLE_MAX_LEAF_FACES}"),
+        ));
+    }
+    for (name, offset, value) in [
+        ("triangles", 32, header.triangles.get()),
+        ("vertices", 36, header.vertices.get()),
+        ("nodes", 40, header.nodes.get()),
+    ] {
+        if value == 0 {
+            return Err(field(name, offset, "is zero"));
+        }
+    }
+    if header.reserved0.get() != 0 || header.reserved1 != [0; 12] {
+        return Err(field("reserved", 60, "reserved bytes are not zero"));
+    }
+
+    let expected = |kind: SectionKind| -> (u64, u32) {
+        match kind {
+            SectionKind::Vertices => (
+                u64::from(header.vertices.get()),
+                3 * u32::from(precision.tag()),
+            ),
+            SectionKind::Faces => (u64::from(header.triangles.get()), 12),
+            SectionKind::SourceIds => (u64::from(header.triangles.get()), 4),
+            SectionKind::Nodes => (
+                u64::from(header.nodes.get()),
+                node_size(bv, precision) as u32,
+            ),
+        }
+    };
+    let data_start = align_up(header_bytes as u64).unwrap_or(u64::MAX);
+    let mut sections = Vec::with_capacity(usize::from(count));
+    let mut required: [Option<Range<usize>>; 4] = Default::default();
+    for (index, raw) in directory.chunks_exact(ENTRY_SIZE).enumerate() {
+        let e = SectionEntry::read_from_bytes(raw).map_err(|_| too_short(header_bytes as u64))?;
+        let info = SectionInfo {
+            kind_tag: e.kind.get(),
+            kind: SectionKind::from_tag(e.kind.get()),
+            flags: e.flags.get(),
+            offset: e.offset.get(),
+            length: e.length.get(),
+            count: e.count.get(),
+            stride: e.stride.get(),
+            crc32: e.crc32.get(),
+        };
+        let bad = |problem: String| FormatError::Section {
+            index,
+            kind: info.name(),
+            problem,
+        };
+        if info.flags & !FLAG_REQUIRED != 0 {
+            return Err(bad(format!("unknown flags {:#x}", info.flags)));
+        }
+        if info.offset % SECTION_ALIGN != 0 || info.offset < data_start {
+            return Err(bad(format!(
+                "offset {} is not a multiple of {SECTION_ALIGN} at or after the directory's end ({data_start})",
+                info.offset
+            )));
+        }
+        let end = info.offset.checked_add(info.length).filter(|&e| e <= len);
+        let Some(end) = end else {
+            return Err(bad(format!(
+                "bytes {}..+{} run past the end of the {len}-byte file",
+                info.offset, info.length
+            )));
+        };
+        if info.count.checked_mul(u64::from(info.stride)) != Some(info.length) {
+            return Err(bad(format!(
+                "count {} x stride {} != length {}",
+                info.count, info.stride, info.length
+            )));
+        }
+        match info.kind {
+            None if info.flags & FLAG_REQUIRED != 0 => {
+                return Err(bad("unknown section kind marked required".into()));
+            }
+            None => {}
+            Some(kind) => {
+                let slot = &mut required[SectionKind::ALL
+                    .iter()
+                    .position(|&k| k == kind)
+                    .unwrap_or(0)];
+                if slot.is_some() {
+                    return Err(bad("duplicate section".into()));
+                }
+                let (want_count, want_stride) = expected(kind);
+                if info.count != want_count || info.stride != want_stride {
+                    return Err(bad(format!(
+                        "{} records of {} bytes, but the header implies {want_count} of {want_stride}",
+                        info.count, info.stride
+                    )));
+                }
+                *slot = Some(info.offset as usize..end as usize);
+            }
+        }
+        sections.push(info);
+    }
+    let mut spans: Vec<(u64, u64, usize)> = sections
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.offset, s.offset + s.length, i))
+        .collect();
+    spans.sort_unstable();
+    for pair in spans.windows(2) {
+        if let [(_, end_a, a), (start_b, _, b)] = pair {
+            if start_b < end_a {
+                return Err(FormatError::Section {
+                    index: *b,
+                    kind: sections[*b].name(),
+                    problem: format!("overlaps section entry {a}"),
+                });
+            }
+        }
+    }
+    let mut ranges: [Range<usize>; 4] = Default::default();
+    for (k, slot) in required.into_iter().enumerate() {
+        ranges[k] = slot.ok_or(FormatError::MissingSection(SectionKind::ALL[k].name()))?;
+    }
+    if encoding == Encoding::Binary
+        && u64::from(header.nodes.get()) != 2 * u64::from(header.triangles.get()) - 1
+    {
+        return Err(field(
+            "nodes",
+            40,
+            "a binary tree with one face per leaf has 2 x triangles - 1 nodes",
+        ));
+    }
+    Ok(Checked {
+        header,
+        sections,
+        required: ranges,
+        bv,
+        precision,
+        encoding,
+        fit,
+    })
+}

@@ -1,0 +1,265 @@
+//! The O(n) checks of `verify`: after them every byte of the file is covered by some check
+//! (header and directory by the header CRC, sections by their CRCs, the rest must be zero),
+//! and the tree is well formed: queries terminate and volumes contain what they claim to.
+
+use super::error::VerifyError;
+use super::layout::SECTION_ALIGN;
+use super::open::{ObbtFile, TreeVisitor};
+use crate::build::TreeStats;
+use crate::bv::BoundingVolume;
+use crate::mesh::triangle_is_degenerate;
+use crate::real::point_to_f64;
+use crate::tree::{NodeRef, TreeView};
+
+pub(crate) fn verify(file: &ObbtFile) -> Result<(), VerifyError> {
+    let bytes = file.bytes();
+    check_padding(file, bytes)?;
+    for (i, s) in file.sections().iter().enumerate() {
+        let data = bytes
+            .get(s.offset as usize..(s.offset + s.length) as usize)
+            .ok_or_else(|| VerifyError::new(format!("section {}", s.name()), "out of bounds"))?;
+        let crc = crc32fast::hash(data);
+        if crc != s.crc32 {
+            return Err(VerifyError::new(
+                format!("section {} (directory entry {i})", s.name()),
+                format!(
+                    "checksum mismatch: stored {:#010x}, computed {crc:#010x}",
+                    s.crc32
+                ),
+            ));
+        }
+    }
+    file.visit(Contents { file })
+        .map_err(|e| VerifyError::new("header", e.to_string()))?
+}
+
+/// Every byte outside the header, directory and sections must be zero, so that no byte of a
+/// file can change without some check noticing.
+fn check_padding(file: &ObbtFile, bytes: &[u8]) -> Result<(), VerifyError> {
+    let mut spans: Vec<(u64, u64)> = file
+        .sections()
+        .iter()
+        .map(|s| (s.offset, s.offset + s.length))
+        .collect();
+    spans.sort_unstable();
+    let mut cursor = u64::from(file.header().header_bytes.get());
+    for (start, end) in spans
+        .into_iter()
+        .chain([(bytes.len() as u64, bytes.len() as u64)])
+    {
+        let gap = bytes.get(cursor as usize..start as usize).unwrap_or(&[]);
+        if let Some(k) = gap.iter().position(|&b| b != 0) {
+            return Err(VerifyError::new(
+                "padding",
+                format!("byte {} is not zero", cursor as usize + k),
+            ));
+        }
+        if start.saturating_sub(cursor) >= SECTION_ALIGN {
+            return Err(VerifyError::new(
+                "padding",
+                format!("{} bytes of padding at {cursor}", start - cursor),
+            ));
+        }
+        cursor = cursor.max(end);
+    }
+    Ok(())
+}
+
+struct Contents<'f> {
+    file: &'f ObbtFile,
+}
+
+impl TreeVisitor for Contents<'_> {
+    type Output = Result<(), VerifyError>;
+
+    fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Result<(), VerifyError> {
+        let info = self.file.info();
+        let positions: Vec<[f64; 3]> = tree.vertices().iter().map(point_to_f64).collect();
+        if let Some(i) = positions
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(VerifyError::new(
+                "section vertices",
+                format!("vertex {i} is not finite"),
+            ));
+        }
+        let n_vertices = positions.len();
+        for (i, f) in tree.faces().iter().enumerate() {
+            if let Some(v) = f.iter().find(|&&v| v as usize >= n_vertices) {
+                return Err(VerifyError::new(
+                    "section faces",
+                    format!("face {i} uses vertex {v}, but there are {n_vertices}"),
+                ));
+            }
+        }
+        let n_faces = tree.faces().len();
+        let mut seen = vec![false; n_faces];
+        for (i, &id) in tree.source_ids().iter().enumerate() {
+            match seen.get_mut(id as usize) {
+                None => {
+                    return Err(VerifyError::new(
+                        "section source_ids",
+                        format!("entry {i} is {id}, but there are {n_faces} triangles"),
+                    ))
+                }
+                Some(true) => {
+                    return Err(VerifyError::new(
+                        "section source_ids",
+                        format!("entry {i} repeats id {id}"),
+                    ));
+                }
+                Some(s) => *s = true,
+            }
+        }
+        check_nodes(&tree, &positions, info.leaf_size)?;
+
+        let (stats, _) = TreeStats::of_nodes(
+            tree.nodes().iter().map(|n| tree.node_ref(n)),
+            tree.nodes().len(),
+        )
+        .ok_or_else(|| VerifyError::new("section nodes", "not a tree"))?;
+        let degenerate = tree
+            .faces()
+            .iter()
+            .filter(|f| {
+                let c = |k: usize| positions[f[k] as usize];
+                triangle_is_degenerate(c(0), c(1), c(2))
+            })
+            .count() as u32;
+        let (lo, hi) = crate::build::bounds_of(&positions);
+        let claims = [
+            ("leaves", info.leaves, stats.leaves),
+            ("depth", info.depth, stats.depth),
+            ("max_leaf_faces", info.max_leaf_faces, stats.max_leaf_faces),
+            (
+                "degenerate_triangles",
+                info.degenerate_triangles,
+                degenerate,
+            ),
+        ];
+        for (name, stored, actual) in claims {
+            if stored != actual {
+                return Err(VerifyError::new(
+                    "header",
+                    format!("{name} is {stored}, but the tree has {actual}"),
+                ));
+            }
+        }
+        if lo != info.bounds_min || hi != info.bounds_max {
+            return Err(VerifyError::new(
+                "header",
+                "model bounds differ from the vertices' extent",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Structure and geometry of the nodes: references in bounds and pointing forward (so every
+/// traversal terminates), each node below exactly one parent, leaves partitioning the faces,
+/// volumes well formed and containing every vertex of every face below them.
+fn check_nodes<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    positions: &[[f64; 3]],
+    leaf_size: u32,
+) -> Result<(), VerifyError> {
+    let nodes = tree.nodes();
+    let n_faces = tree.faces().len() as u64;
+    let bad = |i: usize, problem: String| {
+        VerifyError::new("section nodes", format!("node {i}: {problem}"))
+    };
+    let mut parent = vec![u32::MAX; nodes.len()];
+    let mut face_owner = vec![u32::MAX; tree.faces().len()];
+    for (i, node) in nodes.iter().enumerate() {
+        if i > 0 && parent[i] == u32::MAX {
+            return Err(bad(i, "no parent references it".into()));
+        }
+        node.bv.validate().map_err(|d| bad(i, d.to_string()))?;
+        let r = tree.node_ref(node);
+        let range = r.range();
+        match r {
+            NodeRef::Internal { .. } => {
+                if range.start <= i as u64 || range.end > nodes.len() as u64 {
+                    return Err(bad(
+                        i,
+                        format!(
+                            "children {}..{} are not after it and below {}",
+                            range.start,
+                            range.end,
+                            nodes.len()
+                        ),
+                    ));
+                }
+                for c in range {
+                    let slot = &mut parent[c as usize];
+                    if *slot != u32::MAX {
+                        return Err(bad(i, format!("child {c} already has parent {}", *slot)));
+                    }
+                    *slot = i as u32;
+                }
+            }
+            NodeRef::Leaf { count, .. } => {
+                if range.end > n_faces {
+                    return Err(bad(
+                        i,
+                        format!(
+                            "faces {}..{} exceed the {n_faces} faces",
+                            range.start, range.end
+                        ),
+                    ));
+                }
+                if count > leaf_size {
+                    return Err(bad(
+                        i,
+                        format!("{count} faces exceed the leaf size {leaf_size}"),
+                    ));
+                }
+                for f in range {
+                    let owner = &mut face_owner[f as usize];
+                    if *owner != u32::MAX {
+                        return Err(bad(i, format!("face {f} is also in leaf {}", *owner)));
+                    }
+                    *owner = i as u32;
+                }
+            }
+        }
+    }
+    if let Some(f) = face_owner.iter().position(|&o| o == u32::MAX) {
+        return Err(VerifyError::new(
+            "section nodes",
+            format!("face {f} is in no leaf"),
+        ));
+    }
+    // Containment: each face's corners inside its leaf and every ancestor. The tolerance only
+    // absorbs the f64 arithmetic of this check; the builder rounds volumes outward.
+    let scale = positions
+        .iter()
+        .flatten()
+        .fold(1.0f64, |m, c| m.max(c.abs()));
+    let tolerance = 1e-12 * scale;
+    for (f, &leaf) in face_owner.iter().enumerate() {
+        let corners = tree.faces()[f].map(|v| positions[v as usize]);
+        let mut at = leaf;
+        loop {
+            let node = &nodes[at as usize];
+            if let Some(k) = corners
+                .iter()
+                .position(|&p| !node.bv.contains(p, tolerance))
+            {
+                return Err(bad(
+                    at as usize,
+                    format!(
+                        "volume does not contain corner {k} of face {f} (vertex {})",
+                        tree.faces()[f][k]
+                    ),
+                ));
+            }
+            if at == 0 {
+                break;
+            }
+            at = parent[at as usize];
+        }
+    }
+    Ok(())
+}
