@@ -179,7 +179,7 @@ fn merge<B: BoundingVolume>(bv: B, left: Vec<Draft<B>>, right: Vec<Draft<B>>) ->
         },
     };
     let nl = left.len() as u32;
-    // Left node j >= 1 moves to j + 1 and right node j >= 1 to j + nl; the roots to 1 and 2.
+    // The roots move to 1 and 2, left node j >= 1 to j + 2, right node j >= 1 to j + nl + 1.
     // A local child index is never 0, so shifting every internal reference is exact.
     let mut out = Vec::with_capacity(1 + left.len() + right.len());
     out.push(Draft {
@@ -188,10 +188,10 @@ fn merge<B: BoundingVolume>(bv: B, left: Vec<Draft<B>>, right: Vec<Draft<B>>) ->
     });
     let mut l = left.into_iter();
     let mut r = right.into_iter();
-    out.extend(l.next().map(|d| shift(d, 1)));
-    out.extend(r.next().map(|d| shift(d, nl)));
-    out.extend(l.map(|d| shift(d, 1)));
-    out.extend(r.map(|d| shift(d, nl)));
+    out.extend(l.next().map(|d| shift(d, 2)));
+    out.extend(r.next().map(|d| shift(d, nl + 1)));
+    out.extend(l.map(|d| shift(d, 2)));
+    out.extend(r.map(|d| shift(d, nl + 1)));
     out
 }
 

