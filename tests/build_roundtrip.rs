@@ -1,25 +1,200 @@
+//! Build -> write -> open: identical arrays and bytes, determinism, and volumes that contain
+//! what is below them, for every volume type, both precisions and two leaf sizes.
+
 mod common;
+
 use obbtree::build::{build, BuildOptions};
-use obbtree::bv::BvKind;
-use obbtree::fit::FitMethod;
-use obbtree::real::Precision;
+use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
+use obbtree::format::{ObbtFile, TreeVisitor};
+use obbtree::mesh::TriMesh;
+use obbtree::real::{point_to_f64, Real};
+use obbtree::tree::{Encoding, TreeView};
+
+/// Checks a tree against the mesh it was built from.
+struct MatchesMesh<'m> {
+    mesh: &'m TriMesh,
+    options: BuildOptions,
+}
+
+impl TreeVisitor for MatchesMesh<'_> {
+    type Output = ();
+    fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) {
+        let mesh = self.mesh;
+        assert_eq!(tree.vertices().len(), mesh.vertices().len());
+        for (stored, input) in tree.vertices().iter().zip(mesh.vertices()) {
+            let expected = input.map(<B::Real as Real>::from_f64_nearest);
+            assert_eq!(point_to_f64(stored), point_to_f64(&expected));
+        }
+        for (face, &id) in tree.faces().iter().zip(tree.source_ids()) {
+            assert_eq!(
+                *face,
+                mesh.faces()[id as usize],
+                "face order must follow the source ids"
+            );
+        }
+        // The encoding follows the tree's shape: binary exactly when every leaf has one face
+        // (always with leaf size 1; also for tiny meshes at larger leaf sizes).
+        let single_face_leaves =
+            (0..tree.nodes().len() as u32).all(|i| tree.leaf_faces(i).is_none_or(|f| f.len() == 1));
+        let expected_encoding = if single_face_leaves {
+            Encoding::Binary
+        } else {
+            Encoding::Variable
+        };
+        assert_eq!(tree.encoding(), expected_encoding);
+        assert!(self.options.leaf_size > 1 || expected_encoding == Encoding::Binary);
+        // The volumes are rounded outward, so only the f64 arithmetic of the check itself
+        // needs slack.
+        common::assert_tight_enough(&tree, 1e-12);
+    }
+}
+
+fn check_mesh(mesh: &TriMesh) {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("obbtree-roundtrip-{}-{call}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for options in common::all_options() {
+        let built = build(mesh, &options, None).unwrap();
+        built.verify().unwrap();
+        let path = dir.join("tree.obbt");
+        built.write_atomic(&path).unwrap();
+        let opened = ObbtFile::open(&path).unwrap();
+        assert!(
+            opened.bytes() == built.bytes(),
+            "{options:?}: the file differs from the image"
+        );
+        assert_eq!(opened.info(), built.info());
+        opened.verify().unwrap();
+        opened.visit(MatchesMesh { mesh, options }).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
 
 #[test]
-fn smoke() {
-    let mesh = common::uv_sphere(1.0, 20, 40);
-    for bv in BvKind::ALL {
-        for precision in Precision::ALL {
-            for leaf_size in [1, 4] {
-                let opts = BuildOptions {
-                    bv,
-                    precision,
-                    fit: FitMethod::Hull,
-                    leaf_size,
-                };
-                let f = build(&mesh, &opts, None).unwrap();
-                f.verify().unwrap();
-                println!("{:?}", f.info());
-            }
-        }
+fn sphere_round_trips_for_every_option() {
+    check_mesh(&common::uv_sphere(1.0, 24, 48));
+}
+
+#[test]
+fn cow_round_trips_for_every_option() {
+    check_mesh(&common::cow());
+}
+
+#[test]
+fn flat_and_tiny_meshes_round_trip() {
+    check_mesh(&common::grid(7));
+    check_mesh(&common::cube(0.5));
+    check_mesh(
+        &TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+        )
+        .unwrap(),
+    );
+}
+
+#[test]
+fn degenerate_and_duplicated_triangles_round_trip() {
+    // Collinear, coincident and duplicated triangles: kept, counted, and still enclosed.
+    let vertices = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [5.0, 5.0, 5.0],
+    ];
+    let faces = vec![
+        [0, 1, 2],
+        [4, 4, 4],
+        [0, 1, 3],
+        [0, 1, 3],
+        [0, 1, 3],
+        [1, 2, 3],
+    ];
+    let mesh = TriMesh::new(vertices, faces).unwrap();
+    check_mesh(&mesh);
+    let info = build(&mesh, &BuildOptions::default(), None).unwrap().info();
+    assert_eq!(info.degenerate_triangles, 2);
+}
+
+#[test]
+fn builds_are_byte_identical_whatever_the_thread_count() {
+    let mesh = common::uv_sphere(1.0, 60, 120); // 14k triangles: the parallel levels run
+    for options in [
+        BuildOptions::default(),
+        BuildOptions {
+            leaf_size: 4,
+            ..BuildOptions::default()
+        },
+    ] {
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let four = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        let a = one.install(|| build(&mesh, &options, None).unwrap());
+        let b = four.install(|| build(&mesh, &options, None).unwrap());
+        let c = build(&mesh, &options, None).unwrap();
+        assert!(a.bytes() == b.bytes(), "1 thread and 4 threads differ");
+        assert!(
+            a.bytes() == c.bytes(),
+            "1 thread and the global pool differ"
+        );
     }
+}
+
+#[test]
+fn view_of_the_wrong_type_is_refused() {
+    let file = build(&common::cube(1.0), &BuildOptions::default(), None).unwrap();
+    assert!(file.view::<Obb<f32>>().is_ok());
+    assert!(file.view::<Obb<f64>>().is_err());
+    assert!(file.view::<Aabb<f32>>().is_err());
+    assert!(file.view::<Sphere<f32>>().is_err());
+}
+
+#[test]
+fn leaf_size_out_of_range_is_refused() {
+    for leaf_size in [0, 129] {
+        let options = BuildOptions {
+            leaf_size,
+            ..BuildOptions::default()
+        };
+        let err = build(&common::cube(1.0), &options, None).unwrap_err();
+        assert!(err.to_string().contains("leaf size"), "{err}");
+    }
+}
+
+#[test]
+fn statistics_match_the_tree() {
+    let mesh = common::uv_sphere(2.0, 16, 32);
+    let file = build(&mesh, &BuildOptions::default(), None).unwrap();
+    let info = file.info();
+    let n = mesh.faces().len() as u32;
+    assert_eq!(
+        (info.triangles, info.nodes, info.leaves, info.max_leaf_faces),
+        (n, 2 * n - 1, n, 1)
+    );
+    assert!(
+        info.depth >= 1 + (f64::from(n).log2().ceil() as u32),
+        "depth {}",
+        info.depth
+    );
+    for k in 0..3 {
+        assert!((info.bounds_min[k] + 2.0).abs() < 1e-6 && (info.bounds_max[k] - 2.0).abs() < 1e-6);
+    }
+    let file4 = build(
+        &mesh,
+        &BuildOptions {
+            leaf_size: 4,
+            ..BuildOptions::default()
+        },
+        None,
+    )
+    .unwrap();
+    let info4 = file4.info();
+    assert!(info4.max_leaf_faces <= 4 && info4.leaves < n && info4.nodes == 2 * info4.leaves - 1);
 }

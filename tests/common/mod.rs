@@ -85,11 +85,104 @@ pub fn grid(n: u32) -> TriMesh {
 }
 
 /// The bundled cow (5,804 triangles), loaded from `assets/`.
-#[cfg(any())]
 pub fn cow() -> TriMesh {
     TriMesh::load(std::path::Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/assets/cow.obj"
     )))
     .expect("assets/cow.obj loads")
+}
+
+/// Every option combination the format supports, at leaf sizes 1 and 4.
+pub fn all_options() -> Vec<obbtree::build::BuildOptions> {
+    use obbtree::build::BuildOptions;
+    use obbtree::bv::BvKind;
+    use obbtree::real::Precision;
+    let mut out = Vec::new();
+    for bv in BvKind::ALL {
+        for precision in Precision::ALL {
+            for leaf_size in [1, 4] {
+                out.push(BuildOptions {
+                    bv,
+                    precision,
+                    leaf_size,
+                    ..BuildOptions::default()
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Checks the structural invariants of a tree through its public accessors alone: children
+/// after parents, each node reached once, leaves partitioning the faces, source ids a
+/// permutation. Returns, for each node, the leaf-ordered faces below it.
+pub fn assert_consistent<B: obbtree::bv::BoundingVolume>(
+    tree: &obbtree::tree::TreeView<'_, B>,
+) -> Vec<Vec<u32>> {
+    let n = tree.nodes().len();
+    let mut below: Vec<Vec<u32>> = vec![Vec::new(); n];
+    let mut reached = vec![false; n];
+    reached[0] = true;
+    // Children follow parents, so a reverse sweep sees every child before its parent.
+    let mut children_of = vec![Vec::new(); n];
+    for i in 0..n as u32 {
+        assert!(reached[i as usize], "node {i} is not reached from the root");
+        match (tree.children(i), tree.leaf_faces(i)) {
+            (Some(c), None) => {
+                for child in c {
+                    assert!(child > i);
+                    assert!(!reached[child as usize], "node {child} has two parents");
+                    reached[child as usize] = true;
+                    children_of[i as usize].push(child);
+                }
+            }
+            (None, Some(f)) => below[i as usize] = f.collect(),
+            other => {
+                panic!("node {i} is neither a valid internal node nor a valid leaf: {other:?}")
+            }
+        }
+    }
+    for i in (0..n).rev() {
+        let gathered: Vec<u32> = children_of[i]
+            .iter()
+            .flat_map(|&c| below[c as usize].clone())
+            .collect();
+        below[i].extend(gathered);
+    }
+    let mut root = below[0].clone();
+    root.sort_unstable();
+    assert_eq!(
+        root,
+        (0..tree.faces().len() as u32).collect::<Vec<_>>(),
+        "leaves must partition the faces"
+    );
+    let mut ids = tree.source_ids().to_vec();
+    ids.sort_unstable();
+    assert_eq!(
+        ids,
+        (0..tree.faces().len() as u32).collect::<Vec<_>>(),
+        "source ids must be a permutation"
+    );
+    below
+}
+
+/// Checks that every node's volume contains every corner of every face below it, within
+/// `tolerance` model units.
+pub fn assert_tight_enough<B: obbtree::bv::BoundingVolume>(
+    tree: &obbtree::tree::TreeView<'_, B>,
+    tolerance: f64,
+) {
+    let below = assert_consistent(tree);
+    for (i, faces) in below.iter().enumerate() {
+        let bv = &tree.nodes()[i].bv;
+        for &f in faces {
+            for (k, p) in tree.triangle(f).expect("face in bounds").iter().enumerate() {
+                assert!(
+                    bv.contains(*p, tolerance),
+                    "node {i} ({bv:?}) misses corner {k} {p:?} of face {f}"
+                );
+            }
+        }
+    }
 }
