@@ -198,3 +198,20 @@ fn statistics_match_the_tree() {
     let info4 = file4.info();
     assert!(info4.max_leaf_faces <= 4 && info4.leaves < n && info4.nodes == 2 * info4.leaves - 1);
 }
+
+#[test]
+fn smallest_file_matches_the_spec_test_vector() {
+    // formats/obbt.md § 12: one triangle, OBB f32.
+    let mesh = TriMesh::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]]).unwrap();
+    let file = build(&mesh, &BuildOptions::default(), None).unwrap();
+    let offsets: Vec<(String, u64, u64)> = file.sections().iter().map(|s| (s.name(), s.offset, s.length)).collect();
+    assert_eq!(
+        offsets,
+        [("vertices".into(), 320, 36), ("faces".into(), 384, 12), ("source_ids".into(), 448, 4), ("nodes".into(), 512, 64)]
+    );
+    assert_eq!(file.bytes().len(), 576);
+    assert_eq!(file.info().encoding, Encoding::Binary);
+    let tree = file.view::<Obb<f32>>().unwrap();
+    assert_eq!(tree.nodes()[0].packed, 0);
+    assert_eq!(&file.bytes()[..8], b"\x89OBT\r\n\x1a\n");
+}
