@@ -1,6 +1,28 @@
 //! Triangle soups: the validated input of the builder, and the OBJ / STL loaders.
+//!
+//! Every loader ends in the same checks as [`TriMesh::new`], so a `TriMesh`
+//! always satisfies its invariants however it was made.
+
+mod error;
+mod limits;
+mod load;
+mod obj;
+mod stl;
+mod text;
+mod weld;
+
+pub use error::{Location, MeshError, Place};
+pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
+
+/// Input name used in the errors of [`TriMesh::new`].
+const MEMORY: &str = "<memory>";
 
 /// A validated triangle soup: finite vertex positions and faces whose indices are in range.
+///
+/// Invariants: at least one vertex and one face; at most [`MAX_VERTICES`]
+/// vertices and [`MAX_TRIANGLES`] faces; every coordinate finite; every index
+/// `< vertices().len()`. Zero-area triangles are allowed (see
+/// [`TriMesh::degenerate_triangle_count`]).
 ///
 /// Triangle ids are positions in `faces` (0-based, file order after triangulation).
 #[derive(Clone, Debug, PartialEq)]
@@ -10,62 +32,95 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
-    /// Provisional constructor (replaced by the loader module).
-    pub fn new(vertices: Vec<[f64; 3]>, faces: Vec<[u32; 3]>) -> Result<TriMesh, String> {
-        if vertices.is_empty()
-            || faces.is_empty()
-            || faces
-                .iter()
-                .flatten()
-                .any(|&i| i as usize >= vertices.len())
-        {
-            return Err("bad mesh".into());
+    /// Validates and wraps a vertex and face list: at least one vertex and one
+    /// face, at most [`MAX_VERTICES`] / [`MAX_TRIANGLES`], every index
+    /// `< vertices.len()`, every coordinate finite. Errors name `<memory>` and
+    /// the 0-based vertex or face id at fault.
+    pub fn new(vertices: Vec<[f64; 3]>, faces: Vec<[u32; 3]>) -> Result<TriMesh, MeshError> {
+        TriMesh::validated(MEMORY, vertices, faces)
+    }
+
+    /// [`TriMesh::new`] with the input name `file` in the errors; the loaders'
+    /// last step (they check coordinates and indices first, with line numbers).
+    pub(crate) fn validated(
+        file: &str,
+        vertices: Vec<[f64; 3]>,
+        faces: Vec<[u32; 3]>,
+    ) -> Result<TriMesh, MeshError> {
+        if vertices.is_empty() {
+            return Err(MeshError::EmptyMesh {
+                file: file.to_owned(),
+            });
+        }
+        if faces.is_empty() {
+            return Err(MeshError::NoFaces {
+                file: file.to_owned(),
+                vertex_count: vertices.len(),
+            });
+        }
+        if vertices.len() > MAX_VERTICES {
+            return Err(MeshError::too_large(
+                file,
+                "vertices",
+                vertices.len(),
+                MAX_VERTICES,
+            ));
+        }
+        if faces.len() > MAX_TRIANGLES {
+            return Err(MeshError::too_large(
+                file,
+                "triangles",
+                faces.len(),
+                MAX_TRIANGLES,
+            ));
+        }
+        for (id, position) in vertices.iter().enumerate() {
+            if let Some(&value) = position.iter().find(|c| !c.is_finite()) {
+                return Err(MeshError::NonFinite {
+                    place: Place::new(file, Location::Vertex(id)),
+                    value,
+                });
+            }
+        }
+        for (id, face) in faces.iter().enumerate() {
+            if let Some(&index) = face.iter().find(|&&i| i as usize >= vertices.len()) {
+                return Err(MeshError::IndexOutOfRange {
+                    place: Place::new(file, Location::Face(id)),
+                    index: index.to_string(),
+                    vertex_count: vertices.len(),
+                });
+            }
         }
         Ok(TriMesh { vertices, faces })
     }
-    /// Provisional.
-    pub fn load(path: &std::path::Path) -> Result<TriMesh, String> {
-        let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-        Self::from_obj_bytes(&bytes, "x")
-    }
-    /// Provisional.
-    pub fn from_obj_bytes(bytes: &[u8], _name: &str) -> Result<TriMesh, String> {
-        let text = String::from_utf8_lossy(bytes);
-        let mut v = Vec::new();
-        let mut f = Vec::new();
-        for line in text.lines() {
-            let t: Vec<&str> = line.split_whitespace().collect();
-            match t.first() {
-                Some(&"v") => v.push([
-                    t[1].parse().unwrap(),
-                    t[2].parse().unwrap(),
-                    t[3].parse().unwrap(),
-                ]),
-                Some(&"f") => {
-                    let ix: Vec<u32> = t[1..]
-                        .iter()
-                        .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                        .collect();
-                    for k in 1..ix.len() - 1 {
-                        f.push([ix[0], ix[k], ix[k + 1]]);
-                    }
-                }
-                _ => {}
-            }
-        }
-        Self::new(v, f)
-    }
-    /// Provisional.
-    pub fn degenerate_triangle_count(&self) -> usize {
-        0
-    }
+
     /// The vertex positions, in model units.
     pub fn vertices(&self) -> &[[f64; 3]] {
         &self.vertices
     }
-    /// The triangles, as indices into [`TriMesh::vertices`].
+
+    /// The triangles, as indices into [`TriMesh::vertices`]; a triangle's id is its position here.
     pub fn faces(&self) -> &[[u32; 3]] {
         &self.faces
+    }
+
+    /// Number of zero-area triangles: a repeated vertex index, or coincident or
+    /// collinear positions (an exactly zero cross product in f64). They are
+    /// kept in the mesh because they can still touch other geometry.
+    pub fn degenerate_triangle_count(&self) -> usize {
+        self.faces
+            .iter()
+            .filter(|face| self.is_degenerate(face))
+            .count()
+    }
+
+    /// Whether `face` has zero area (see [`TriMesh::degenerate_triangle_count`]).
+    fn is_degenerate(&self, face: &[u32; 3]) -> bool {
+        // Indices are validated at construction, so the lookups always succeed.
+        match face.map(|i| self.vertices.get(i as usize)) {
+            [Some(p), Some(q), Some(r)] => triangle_is_degenerate(*p, *q, *r),
+            _ => true,
+        }
     }
 }
 
