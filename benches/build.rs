@@ -22,31 +22,56 @@ use std::path::Path;
 use std::time::Duration;
 
 fn shared_mesh(name: &str) -> Option<TriMesh> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/meshes")
+        .join(name);
     if !path.exists() {
-        eprintln!("skipping benchmarks on {name}: {} not found", path.display());
+        eprintln!(
+            "skipping benchmarks on {name}: {} not found",
+            path.display()
+        );
         return None;
     }
     Some(TriMesh::load(&path).expect("shared mesh loads"))
 }
 
 fn build_throughput(c: &mut Criterion) {
-    let Some(bunny) = shared_mesh("bunny.obj") else { return };
+    let Some(bunny) = shared_mesh("bunny.obj") else {
+        return;
+    };
     let mut group = c.benchmark_group("build");
-    group.sample_size(10).measurement_time(Duration::from_secs(8));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(8));
     group.throughput(Throughput::Elements(bunny.faces().len() as u64));
     for fit in FitMethod::ALL {
-        let options = BuildOptions { fit, ..BuildOptions::default() };
-        group.bench_with_input(BenchmarkId::new("bunny", fit.name()), &options, |b, options| {
-            b.iter(|| build(&bunny, options, None).expect("bunny builds"))
-        });
+        let options = BuildOptions {
+            fit,
+            ..BuildOptions::default()
+        };
+        group.bench_with_input(
+            BenchmarkId::new("bunny", fit.name()),
+            &options,
+            |b, options| b.iter(|| build(&bunny, options, None).expect("bunny builds")),
+        );
     }
     group.finish();
 
     println!("\nfile size per triangle, bunny.obj, OBB f32, hull fit:");
-    println!("{:>10} {:>12} {:>10} {:>10}", "leaf size", "bytes", "nodes", "B/tri");
+    println!(
+        "{:>10} {:>12} {:>10} {:>10}",
+        "leaf size", "bytes", "nodes", "B/tri"
+    );
     for leaf_size in [1, 2, 4, 8] {
-        let file = build(&bunny, &BuildOptions { leaf_size, ..BuildOptions::default() }, None).expect("builds");
+        let file = build(
+            &bunny,
+            &BuildOptions {
+                leaf_size,
+                ..BuildOptions::default()
+            },
+            None,
+        )
+        .expect("builds");
         let info = file.info();
         println!(
             "{:>10} {:>12} {:>10} {:>10.1}",
@@ -65,9 +90,18 @@ fn open_time(c: &mut Criterion) {
     let small = dir.join("cube.obbt");
     // 2 * 500 * 999 + ... = 1,000,000 triangles: 2 * slices * (stacks - 1).
     let sphere = common::uv_sphere(1.0, 501, 1000);
-    let options = BuildOptions { fit: FitMethod::Triangles, ..BuildOptions::default() };
-    build(&sphere, &options, None).expect("builds").write_atomic(&large).expect("writes");
-    build(&common::cube(1.0), &options, None).expect("builds").write_atomic(&small).expect("writes");
+    let options = BuildOptions {
+        fit: FitMethod::Triangles,
+        ..BuildOptions::default()
+    };
+    build(&sphere, &options, None)
+        .expect("builds")
+        .write_atomic(&large)
+        .expect("writes");
+    build(&common::cube(1.0), &options, None)
+        .expect("builds")
+        .write_atomic(&small)
+        .expect("writes");
     let mut group = c.benchmark_group("open");
     for (name, path) in [("1M-triangles", &large), ("12-triangles", &small)] {
         let bytes = std::fs::metadata(path).expect("exists").len();

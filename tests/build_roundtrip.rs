@@ -202,12 +202,25 @@ fn statistics_match_the_tree() {
 #[test]
 fn smallest_file_matches_the_spec_test_vector() {
     // formats/obbt.md § 12: one triangle, OBB f32.
-    let mesh = TriMesh::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]]).unwrap();
+    let mesh = TriMesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
     let file = build(&mesh, &BuildOptions::default(), None).unwrap();
-    let offsets: Vec<(String, u64, u64)> = file.sections().iter().map(|s| (s.name(), s.offset, s.length)).collect();
+    let offsets: Vec<(String, u64, u64)> = file
+        .sections()
+        .iter()
+        .map(|s| (s.name(), s.offset, s.length))
+        .collect();
     assert_eq!(
         offsets,
-        [("vertices".into(), 320, 36), ("faces".into(), 384, 12), ("source_ids".into(), 448, 4), ("nodes".into(), 512, 64)]
+        [
+            ("vertices".into(), 320, 36),
+            ("faces".into(), 384, 12),
+            ("source_ids".into(), 448, 4),
+            ("nodes".into(), 512, 64)
+        ]
     );
     assert_eq!(file.bytes().len(), 576);
     assert_eq!(file.info().encoding, Encoding::Binary);

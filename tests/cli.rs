@@ -4,7 +4,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn obbtree(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_obbtree")).args(args).output().expect("the binary runs")
+    Command::new(env!("CARGO_BIN_EXE_obbtree"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -25,12 +28,19 @@ fn stderr(o: &Output) -> String {
 fn assert_bad_input(o: &Output, needle: &str) {
     let err = stderr(o);
     assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "one line expected: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one line expected: {err}"
+    );
     assert!(err.contains(needle), "{needle:?} not in {err:?}");
 }
 
 fn build(out: &Path, extra: &[&str]) {
-    let mut args = vec!["build", &cow(), "-o", out.to_str().unwrap(), "--quiet"].into_iter().map(String::from).collect::<Vec<_>>();
+    let mut args = vec!["build", &cow(), "-o", out.to_str().unwrap(), "--quiet"]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
     args.extend(extra.iter().map(|s| s.to_string()));
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
     let o = obbtree(&refs);
@@ -49,7 +59,17 @@ fn build_info_verify_on_the_bundled_cow() {
     assert_eq!(v["vertices"], 2904);
     assert_eq!(v["nodes"], 2 * 5804 - 1);
     assert_eq!(v["leaves"], 5804);
-    for key in ["depth", "bv", "precision", "fit", "leaf_size", "encoding", "file_bytes", "bytes_per_triangle", "sections"] {
+    for key in [
+        "depth",
+        "bv",
+        "precision",
+        "fit",
+        "leaf_size",
+        "encoding",
+        "file_bytes",
+        "bytes_per_triangle",
+        "sections",
+    ] {
         assert!(!v[key].is_null(), "info --json lacks {key}");
     }
     assert_eq!(v["bv"], "obb");
@@ -57,7 +77,12 @@ fn build_info_verify_on_the_bundled_cow() {
     assert_eq!(v["fit"], "hull");
     assert_eq!(v["encoding"], "binary");
     assert_eq!(v["file_bytes"], std::fs::metadata(&out).unwrap().len());
-    let names: Vec<&str> = v["sections"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
+    let names: Vec<&str> = v["sections"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
     assert_eq!(names, ["vertices", "faces", "source_ids", "nodes"]);
     for s in v["sections"].as_array().unwrap() {
         assert_eq!(s["offset"].as_u64().unwrap() % 64, 0);
@@ -78,9 +103,25 @@ fn every_volume_precision_and_leaf_size_builds_and_verifies() {
             for leaf in ["1", "4"] {
                 for fit in ["hull", "triangles", "vertices"] {
                     let out = dir.join(format!("{bv}-{precision}-{leaf}-{fit}.obbt"));
-                    build(&out, &["--bv", bv, "--precision", precision, "--leaf-size", leaf, "--fit", fit]);
+                    build(
+                        &out,
+                        &[
+                            "--bv",
+                            bv,
+                            "--precision",
+                            precision,
+                            "--leaf-size",
+                            leaf,
+                            "--fit",
+                            fit,
+                        ],
+                    );
                     let o = obbtree(&["verify", out.to_str().unwrap()]);
-                    assert!(o.status.success(), "{bv} {precision} {leaf} {fit}: {}", stderr(&o));
+                    assert!(
+                        o.status.success(),
+                        "{bv} {precision} {leaf} {fit}: {}",
+                        stderr(&o)
+                    );
                 }
             }
         }
@@ -93,7 +134,9 @@ fn two_builds_are_byte_identical() {
     let dir = scratch("determinism");
     build(&dir.join("a.obbt"), &["--leaf-size", "4"]);
     build(&dir.join("b.obbt"), &["--leaf-size", "4"]);
-    assert!(std::fs::read(dir.join("a.obbt")).unwrap() == std::fs::read(dir.join("b.obbt")).unwrap());
+    assert!(
+        std::fs::read(dir.join("a.obbt")).unwrap() == std::fs::read(dir.join("b.obbt")).unwrap()
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -110,7 +153,10 @@ fn damaged_files_fail_with_one_line() {
     let at = bytes.len() - 200;
     flipped[at] ^= 0x40;
     std::fs::write(&path, &flipped).unwrap();
-    assert!(obbtree(&["info", damaged]).status.success(), "info reads only the header");
+    assert!(
+        obbtree(&["info", damaged]).status.success(),
+        "info reads only the header"
+    );
     assert_bad_input(&obbtree(&["verify", damaged]), "nodes");
     // A flipped header byte: even info refuses.
     let mut header = bytes.clone();
@@ -135,15 +181,35 @@ fn bad_input_is_exit_1_and_usage_errors_exit_2() {
     let dir = scratch("bad");
     let out = dir.join("x.obbt");
     let out = out.to_str().unwrap();
-    assert_bad_input(&obbtree(&["info", "/nonexistent/file.obbt"]), "/nonexistent/file.obbt");
-    assert_bad_input(&obbtree(&["build", "/nonexistent/mesh.obj", "-o", out]), "/nonexistent/mesh.obj");
+    assert_bad_input(
+        &obbtree(&["info", "/nonexistent/file.obbt"]),
+        "/nonexistent/file.obbt",
+    );
+    assert_bad_input(
+        &obbtree(&["build", "/nonexistent/mesh.obj", "-o", out]),
+        "/nonexistent/mesh.obj",
+    );
     let broken = dir.join("broken.obj");
     std::fs::write(&broken, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
-    assert_bad_input(&obbtree(&["build", broken.to_str().unwrap(), "-o", out]), "broken.obj");
+    assert_bad_input(
+        &obbtree(&["build", broken.to_str().unwrap(), "-o", out]),
+        "broken.obj",
+    );
     assert!(!Path::new(out).exists(), "a failed build writes nothing");
-    assert_bad_input(&obbtree(&["build", &cow(), "-o", "/nonexistent/dir/x.obbt", "--quiet"]), "/nonexistent/dir/x.obbt");
-    assert_bad_input(&obbtree(&["build", &cow(), "-o", out, "--leaf-size", "0", "--quiet"]), "leaf size");
-    for args in [&["build", &cow()][..], &["build", &cow(), "-o", out, "--bv", "cone"], &["frobnicate"], &["info"]] {
+    assert_bad_input(
+        &obbtree(&["build", &cow(), "-o", "/nonexistent/dir/x.obbt", "--quiet"]),
+        "/nonexistent/dir/x.obbt",
+    );
+    assert_bad_input(
+        &obbtree(&["build", &cow(), "-o", out, "--leaf-size", "0", "--quiet"]),
+        "leaf size",
+    );
+    for args in [
+        &["build", &cow()][..],
+        &["build", &cow(), "-o", out, "--bv", "cone"],
+        &["frobnicate"],
+        &["info"],
+    ] {
         let o = obbtree(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
@@ -155,5 +221,8 @@ fn demo_runs() {
     let o = obbtree(&["demo"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
-    assert!(text.contains("5804 triangles") && text.contains("file == memory: yes"), "{text}");
+    assert!(
+        text.contains("5804 triangles") && text.contains("file == memory: yes"),
+        "{text}"
+    );
 }

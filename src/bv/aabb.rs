@@ -1,9 +1,10 @@
 //! Axis-aligned bounding box in the model frame.
 
 use super::obb::box_measures;
+use super::pair::{BoxPair, Transform};
 use super::{all_finite, face_vertices, BoundingVolume, BvDefect, BvKind};
 use crate::real::{point_to_f64, Real};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
 /// The box `min <= p <= max` (componentwise) in the model frame.
@@ -21,6 +22,23 @@ pub struct Aabb<R> {
 }
 
 impl<R: Real> Aabb<R> {
+    /// Centre and half-widths, widened. Under a relative rotation the other model's box is
+    /// no longer axis-aligned, so pair tests treat both as oriented boxes with model axes.
+    #[inline]
+    fn center_half(&self) -> (Vector3<f64>, Vector3<f64>) {
+        let lo = Vector3::from(point_to_f64(&self.min));
+        let hi = Vector3::from(point_to_f64(&self.max));
+        ((lo + hi) * 0.5, (hi - lo) * 0.5)
+    }
+
+    #[inline]
+    fn pair_with(&self, other: &Self, xf: &Transform) -> BoxPair {
+        let (ca, ha) = self.center_half();
+        let (cb, hb) = other.center_half();
+        let identity = Matrix3::identity();
+        BoxPair::new(&identity, &ca, ha, &identity, &cb, hb, xf)
+    }
+
     fn half_f64(&self) -> [f64; 3] {
         std::array::from_fn(|i| 0.5 * (self.max[i].to_f64() - self.min[i].to_f64()))
     }
@@ -69,6 +87,21 @@ impl<R: Real> BoundingVolume for Aabb<R> {
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
         (0..3).all(|i| p[i] >= lo[i] - tolerance && p[i] <= hi[i] + tolerance)
+    }
+
+    #[inline]
+    fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool {
+        !self.pair_with(other, xf).disjoint(guard)
+    }
+
+    #[inline]
+    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        self.pair_with(other, xf).distance_lower_bound()
+    }
+
+    #[inline]
+    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        self.pair_with(other, xf).max_distance()
     }
 
     fn diameter(&self) -> f64 {

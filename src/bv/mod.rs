@@ -7,6 +7,7 @@
 
 mod aabb;
 mod obb;
+pub mod pair;
 mod sphere;
 
 pub use aabb::Aabb;
@@ -15,6 +16,7 @@ pub use sphere::Sphere;
 
 use crate::real::Real;
 use nalgebra::Matrix3;
+use pair::Transform;
 use std::fmt::Debug;
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
@@ -110,6 +112,19 @@ pub trait BoundingVolume:
 
     /// Whether model-frame point `p` lies inside, allowing `tolerance` model units of slack.
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool;
+
+    /// Whether this volume (model A's frame) and `other` (model B's frame, mapped into A's by
+    /// `xf`) may intersect. Conservative: `false` only if they are certainly disjoint. `guard`
+    /// is the separating-axis guard of §4.5 ([`pair::SAT_GUARD`]; boxes only).
+    fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool;
+
+    /// A lower bound on the distance between this volume and `other` (posed as in
+    /// [`BoundingVolume::overlaps`]); 0 when they may overlap.
+    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64;
+
+    /// An upper bound on the largest distance between a point of this volume and a point of
+    /// `other` (posed as in [`BoundingVolume::overlaps`]).
+    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64;
 
     /// Largest distance between two points of the volume (model units).
     fn diameter(&self) -> f64;

@@ -1,8 +1,9 @@
 //! Oriented bounding box (dissertation §3.2).
 
+use super::pair::{BoxPair, Transform};
 use super::{all_finite, face_vertices, l1, projection_slack, BoundingVolume, BvDefect, BvKind};
 use crate::real::{point_to_f64, Precision, Real};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
 /// An oriented box: the points `c + Σ t_i a_i` with `|t_i| <= h_i`, in the model frame.
@@ -24,6 +25,36 @@ pub struct Obb<R> {
 }
 
 impl<R: Real> Obb<R> {
+    /// The axes as the rows of a matrix, widened.
+    #[inline]
+    pub fn axes_matrix(&self) -> Matrix3<f64> {
+        let a = &self.axes;
+        Matrix3::new(
+            a[0][0].to_f64(),
+            a[0][1].to_f64(),
+            a[0][2].to_f64(),
+            a[1][0].to_f64(),
+            a[1][1].to_f64(),
+            a[1][2].to_f64(),
+            a[2][0].to_f64(),
+            a[2][1].to_f64(),
+            a[2][2].to_f64(),
+        )
+    }
+
+    #[inline]
+    fn pair_with(&self, other: &Self, xf: &Transform) -> BoxPair {
+        BoxPair::new(
+            &self.axes_matrix(),
+            &Vector3::from(self.center_f64()),
+            Vector3::from(self.half_f64()),
+            &other.axes_matrix(),
+            &Vector3::from(other.center_f64()),
+            Vector3::from(other.half_f64()),
+            xf,
+        )
+    }
+
     /// The axes widened to f64, one per row.
     pub fn axes_f64(&self) -> [[f64; 3]; 3] {
         self.axes.map(|a| point_to_f64(&a))
@@ -146,6 +177,21 @@ impl<R: Real> BoundingVolume for Obb<R> {
         let h = self.half_f64();
         let a = self.axes_f64();
         (0..3).all(|i| dot(&a[i], &d).abs() <= h[i] + tolerance)
+    }
+
+    #[inline]
+    fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool {
+        !self.pair_with(other, xf).disjoint(guard)
+    }
+
+    #[inline]
+    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        self.pair_with(other, xf).distance_lower_bound()
+    }
+
+    #[inline]
+    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        self.pair_with(other, xf).max_distance()
     }
 
     fn diameter(&self) -> f64 {

@@ -1,9 +1,10 @@
 //! Bounding sphere.
 
 use super::obb::dot;
+use super::pair::Transform;
 use super::{all_finite, face_vertices, l1, projection_slack, BoundingVolume, BvDefect, BvKind};
 use crate::real::{point_to_f64, Real};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
 /// The ball `|p - center| <= radius` in the model frame.
@@ -18,6 +19,15 @@ pub struct Sphere<R> {
     pub center: [R; 3],
     /// Radius, non-negative, model units.
     pub radius: R,
+}
+
+impl<R: Real> Sphere<R> {
+    /// Distance between the centres once `other` is mapped into this sphere's model frame.
+    #[inline]
+    fn center_distance(&self, other: &Self, xf: &Transform) -> f64 {
+        let cb = xf.apply(&Vector3::from(point_to_f64(&other.center)));
+        (cb - Vector3::from(point_to_f64(&self.center))).norm()
+    }
 }
 
 impl<R: Real> BoundingVolume for Sphere<R> {
@@ -80,6 +90,27 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         let c = point_to_f64(&self.center);
         let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
         dot(&d, &d).sqrt() <= self.radius.to_f64() + tolerance
+    }
+
+    #[inline]
+    fn overlaps(&self, other: &Self, xf: &Transform, _guard: f64) -> bool {
+        // A few ulps of slack: the mapped centre is rounded, and a sphere test must never
+        // reject a pair that touches.
+        let (d, r) = (
+            self.center_distance(other, xf),
+            self.radius.to_f64() + other.radius.to_f64(),
+        );
+        d - r <= 8.0 * f64::EPSILON * (d + r)
+    }
+
+    #[inline]
+    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        (self.center_distance(other, xf) - self.radius.to_f64() - other.radius.to_f64()).max(0.0)
+    }
+
+    #[inline]
+    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        self.center_distance(other, xf) + self.radius.to_f64() + other.radius.to_f64()
     }
 
     fn diameter(&self) -> f64 {

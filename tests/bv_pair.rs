@@ -1,0 +1,187 @@
+//! Pair tests of volumes under a relative pose: overlap is conservative, the distance lower
+//! bound is a lower bound, the box maximum distance is exact.
+
+use nalgebra::{Matrix3, Rotation3, Vector3};
+use obbtree::bv::pair::{BoxPair, Transform, SAT_GUARD};
+use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
+use proptest::prelude::*;
+
+fn rotation(ax: f64, ay: f64, az: f64) -> Matrix3<f64> {
+    *Rotation3::from_euler_angles(ax, ay, az).matrix()
+}
+
+fn obb(rot: Matrix3<f64>, c: Vector3<f64>, h: Vector3<f64>) -> Obb<f64> {
+    // Axes as rows.
+    let r = rot.transpose();
+    Obb {
+        axes: [
+            [r[(0, 0)], r[(0, 1)], r[(0, 2)]],
+            [r[(1, 0)], r[(1, 1)], r[(1, 2)]],
+            [r[(2, 0)], r[(2, 1)], r[(2, 2)]],
+        ],
+        center: [c.x, c.y, c.z],
+        half: [h.x, h.y, h.z],
+    }
+}
+
+/// Points of an OBB in its model frame at box coordinates `s` in [-1, 1]^3.
+fn point_of(b: &Obb<f64>, s: [f64; 3]) -> Vector3<f64> {
+    let mut p = Vector3::from(b.center);
+    for i in 0..3 {
+        p += Vector3::from(b.axes[i]) * (s[i] * b.half[i]);
+    }
+    p
+}
+
+fn corners(b: &Obb<f64>) -> Vec<Vector3<f64>> {
+    (0..8)
+        .map(|k| {
+            point_of(
+                b,
+                [
+                    if k & 1 == 0 { -1.0 } else { 1.0 },
+                    if k & 2 == 0 { -1.0 } else { 1.0 },
+                    if k & 4 == 0 { -1.0 } else { 1.0 },
+                ],
+            )
+        })
+        .collect()
+}
+
+fn grid_points(b: &Obb<f64>, n: usize) -> Vec<Vector3<f64>> {
+    let t = |i: usize| -1.0 + 2.0 * i as f64 / (n - 1) as f64;
+    let mut out = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                out.push(point_of(b, [t(i), t(j), t(k)]));
+            }
+        }
+    }
+    out
+}
+
+fn arb_box() -> impl Strategy<Value = Obb<f64>> {
+    (
+        -3.0..3.0f64,
+        -3.0..3.0f64,
+        -3.0..3.0f64,
+        -2.0..2.0f64,
+        -2.0..2.0f64,
+        -2.0..2.0f64,
+        0.0..1.5f64,
+        0.0..1.5f64,
+        0.0..1.5f64,
+    )
+        .prop_map(|(a, b, c, x, y, z, h0, h1, h2)| {
+            obb(
+                rotation(a, b, c),
+                Vector3::new(x, y, z),
+                Vector3::new(h0, h1, h2),
+            )
+        })
+}
+
+fn arb_transform() -> impl Strategy<Value = Transform> {
+    (
+        -3.0..3.0f64,
+        -3.0..3.0f64,
+        -3.0..3.0f64,
+        -2.0..2.0f64,
+        -2.0..2.0f64,
+        -2.0..2.0f64,
+    )
+        .prop_map(|(a, b, c, x, y, z)| Transform {
+            rotation: rotation(a, b, c),
+            translation: Vector3::new(x, y, z),
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn box_max_distance_is_the_corner_maximum(a in arb_box(), b in arb_box(), xf in arb_transform()) {
+        let brute = corners(&a).iter().flat_map(|p| corners(&b).into_iter().map(move |q| (p - xf.apply(&q)).norm())).fold(0.0, f64::max);
+        let fast = a.max_distance_upper_bound(&b, &xf);
+        prop_assert!((fast - brute).abs() <= 1e-9 * (1.0 + brute), "fast {fast} brute {brute}");
+    }
+
+    #[test]
+    fn box_lower_bound_never_exceeds_a_point_pair_distance(a in arb_box(), b in arb_box(), xf in arb_transform()) {
+        let lb = a.distance_lower_bound(&b, &xf);
+        let pa = grid_points(&a, 4);
+        let pb: Vec<_> = grid_points(&b, 4).iter().map(|q| xf.apply(q)).collect();
+        let sampled = pa.iter().flat_map(|p| pb.iter().map(move |q| (p - q).norm())).fold(f64::INFINITY, f64::min);
+        prop_assert!(lb <= sampled + 1e-12, "lower bound {lb} > sampled {sampled}");
+        // A positive bound means the boxes are disjoint, which the overlap test must not contradict
+        // beyond its guard, and an overlap verdict of "disjoint" needs separation.
+        if !a.overlaps(&b, &xf, SAT_GUARD) {
+            prop_assert!(sampled > 0.0);
+        }
+    }
+
+    #[test]
+    fn overlap_is_never_missed(a in arb_box(), b in arb_box(), xf in arb_transform()) {
+        // If some point of B lies inside A, the boxes overlap and the test must say so.
+        let inside = grid_points(&b, 5).iter().any(|q| a.contains(xf.apply(q).into(), 1e-12));
+        if inside {
+            prop_assert!(a.overlaps(&b, &xf, SAT_GUARD));
+            prop_assert!(a.overlaps(&b, &xf, 0.0));
+            prop_assert_eq!(a.distance_lower_bound(&b, &xf), 0.0);
+        }
+    }
+
+    #[test]
+    fn spheres_and_aabbs_agree_with_points(c1 in prop::array::uniform3(-2.0..2.0f64), c2 in prop::array::uniform3(-2.0..2.0f64), r1 in 0.0..1.5f64, r2 in 0.0..1.5f64, xf in arb_transform()) {
+        let s1 = Sphere { center: c1, radius: r1 };
+        let s2 = Sphere { center: c2, radius: r2 };
+        let d = (Vector3::from(c1) - xf.apply(&Vector3::from(c2))).norm();
+        prop_assert_eq!(s1.overlaps(&s2, &xf, 0.0), d <= r1 + r2);
+        prop_assert!((s1.distance_lower_bound(&s2, &xf) - (d - r1 - r2).max(0.0)).abs() < 1e-12);
+        prop_assert!((s1.max_distance_upper_bound(&s2, &xf) - (d + r1 + r2)).abs() < 1e-12);
+        let lo1 = [c1[0] - r1, c1[1] - r1, c1[2] - r1];
+        let hi1 = [c1[0] + r1, c1[1] + r1, c1[2] + r1];
+        let lo2 = [c2[0] - r2, c2[1] - r2, c2[2] - r2];
+        let hi2 = [c2[0] + r2, c2[1] + r2, c2[2] + r2];
+        let a1 = Aabb { min: lo1, max: hi1 };
+        let a2 = Aabb { min: lo2, max: hi2 };
+        let o1 = obb(Matrix3::identity(), Vector3::from(c1), Vector3::repeat(r1));
+        let o2 = obb(Matrix3::identity(), Vector3::from(c2), Vector3::repeat(r2));
+        prop_assert_eq!(a1.overlaps(&a2, &xf, SAT_GUARD), o1.overlaps(&o2, &xf, SAT_GUARD));
+        prop_assert!((a1.max_distance_upper_bound(&a2, &xf) - o1.max_distance_upper_bound(&o2, &xf)).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
+    let a = obb(
+        Matrix3::identity(),
+        Vector3::zeros(),
+        Vector3::new(1.0, 1.0, 1.0),
+    );
+    let b = obb(
+        Matrix3::identity(),
+        Vector3::zeros(),
+        Vector3::new(0.5, 0.5, 0.5),
+    );
+    let xf = Transform {
+        rotation: Matrix3::identity(),
+        translation: Vector3::new(3.0, 0.0, 0.0),
+    };
+    assert!(!a.overlaps(&b, &xf, SAT_GUARD));
+    assert!((a.distance_lower_bound(&b, &xf) - 1.5).abs() < 1e-15);
+    // Farthest corners: (-1, ±1, ±1) and (3.5, ∓0.5, ∓0.5).
+    let expected = (4.5f64 * 4.5 + 1.5 * 1.5 + 1.5 * 1.5).sqrt();
+    assert!((a.max_distance_upper_bound(&b, &xf) - expected).abs() < 1e-12);
+    let pair = BoxPair::new(
+        &Matrix3::identity(),
+        &Vector3::zeros(),
+        Vector3::repeat(1.0),
+        &Matrix3::identity(),
+        &Vector3::zeros(),
+        Vector3::repeat(0.5),
+        &xf,
+    );
+    assert!(pair.disjoint(0.0));
+}
