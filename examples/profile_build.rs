@@ -1,0 +1,34 @@
+//! Builds a mesh repeatedly (for profiling the builder): `cargo run --release --example profile_build -- MESH [FIT] [N]`.
+use obbtree::build::{build, BuildOptions};
+use obbtree::fit::FitMethod;
+use obbtree::mesh::TriMesh;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let Some(path) = args.get(1) else {
+        eprintln!("usage: profile_build MESH [hull|triangles|vertices] [REPEATS]");
+        std::process::exit(2);
+    };
+    let mesh = TriMesh::load(path.as_ref()).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(1)
+    });
+    let fit = args
+        .get(2)
+        .and_then(|s| FitMethod::from_name(s))
+        .unwrap_or_default();
+    let repeats: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let options = BuildOptions {
+        fit,
+        ..BuildOptions::default()
+    };
+    for _ in 0..repeats {
+        let started = std::time::Instant::now();
+        let file = build(&mesh, &options, None).expect("builds");
+        println!(
+            "{} nodes in {:.1} ms",
+            file.info().nodes,
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
+}

@@ -1,0 +1,154 @@
+//! Weighted first and second moments, and the covariance matrices built from them.
+//!
+//! Two kinds of distribution are accumulated:
+//! * the uniform area distribution over triangles (dissertation §3.4, closed form): a
+//!   triangle `(p, q, r)` of area `A` and centroid `m` contributes weight `A`, first moment
+//!   `A m` and second moment `A/12 (9 m mᵀ + p pᵀ + q qᵀ + r rᵀ)`;
+//! * unit point masses (the vertex covariance, §3.3).
+//!
+//! Callers pass coordinates relative to a reference point close to the data (the
+//! covariance is translation invariant); that keeps the final `E[x xᵀ] − m mᵀ`
+//! subtraction free of catastrophic cancellation for data far from the origin.
+
+use super::vec3::{cross, norm2, V3};
+
+/// A symmetric 3×3 matrix stored as `[xx, yy, zz, xy, xz, yz]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Sym3(pub [f64; 6]);
+
+impl Sym3 {
+    /// Row `i` of the matrix.
+    #[inline]
+    pub(crate) fn row(&self, i: usize) -> V3 {
+        let [xx, yy, zz, xy, xz, yz] = self.0;
+        match i {
+            0 => [xx, xy, xz],
+            1 => [xy, yy, yz],
+            _ => [xz, yz, zz],
+        }
+    }
+
+    /// The bilinear form `aᵀ C b`.
+    #[inline]
+    pub(crate) fn form(&self, a: V3, b: V3) -> f64 {
+        let cb = [
+            super::vec3::dot(self.row(0), b),
+            super::vec3::dot(self.row(1), b),
+            super::vec3::dot(self.row(2), b),
+        ];
+        super::vec3::dot(a, cb)
+    }
+
+    /// True when every entry is finite.
+    #[inline]
+    pub(crate) fn is_finite(&self) -> bool {
+        self.0.iter().all(|v| v.is_finite())
+    }
+
+    /// The largest absolute entry (a cheap norm for relative tolerances).
+    #[inline]
+    pub(crate) fn max_abs(&self) -> f64 {
+        self.0.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+    }
+}
+
+/// What a [`Moments`] has accumulated, which fixes the scale of its raw sums.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Kind {
+    /// Nothing yet.
+    #[default]
+    Empty,
+    /// Triangles: weight is twice the area, first moment three times, second moment
+    /// twelve times the true sums (see [`Moments::add_triangle`]).
+    Area,
+    /// Unit point masses: the sums are exact.
+    Points,
+}
+
+/// Running sums of weight, first moment and second moment about the reference origin.
+/// One accumulator holds either triangles or points, not both.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Moments {
+    kind: Kind,
+    /// Scaled total weight (see [`Kind`]).
+    weight: f64,
+    first: V3,
+    /// Second moment `Σ w x xᵀ`, same layout as [`Sym3`].
+    second: [f64; 6],
+}
+
+impl Moments {
+    /// Adds the uniform area distribution of triangle `(p, q, r)`.
+    ///
+    /// With `s = p + q + r = 3m`, the second-moment term `9 m mᵀ` is `s sᵀ`, and the
+    /// factors ½ (area from the cross product), ⅓ and 1/12 are applied once in
+    /// [`Moments::covariance`]: the per-triangle work is one square root, no division.
+    #[inline]
+    pub(crate) fn add_triangle(&mut self, p: V3, q: V3, r: V3) {
+        let n = cross(
+            [q[0] - p[0], q[1] - p[1], q[2] - p[2]],
+            [r[0] - p[0], r[1] - p[1], r[2] - p[2]],
+        );
+        let w = norm2(n).sqrt(); // twice the area
+        let s = [p[0] + q[0] + r[0], p[1] + q[1] + r[1], p[2] + q[2] + r[2]];
+        let e = |j: usize, k: usize| s[j] * s[k] + p[j] * p[k] + q[j] * q[k] + r[j] * r[k];
+        self.weight += w;
+        self.first[0] += w * s[0];
+        self.first[1] += w * s[1];
+        self.first[2] += w * s[2];
+        self.second[0] += w * e(0, 0);
+        self.second[1] += w * e(1, 1);
+        self.second[2] += w * e(2, 2);
+        self.second[3] += w * e(0, 1);
+        self.second[4] += w * e(0, 2);
+        self.second[5] += w * e(1, 2);
+        self.kind = Kind::Area;
+    }
+
+    /// Adds a unit point mass at `p`.
+    #[inline]
+    pub(crate) fn add_point(&mut self, p: V3) {
+        self.weight += 1.0;
+        self.kind = Kind::Points;
+        self.first[0] += p[0];
+        self.first[1] += p[1];
+        self.first[2] += p[2];
+        self.second[0] += p[0] * p[0];
+        self.second[1] += p[1] * p[1];
+        self.second[2] += p[2] * p[2];
+        self.second[3] += p[0] * p[1];
+        self.second[4] += p[0] * p[2];
+        self.second[5] += p[1] * p[2];
+    }
+
+    /// Total weight accumulated, up to a positive factor (zero when there is none).
+    #[inline]
+    pub(crate) fn weight(&self) -> f64 {
+        self.weight
+    }
+
+    /// The covariance `Σ w x xᵀ / Σ w − m mᵀ`, or `None` when the weight is not positive
+    /// or the result is not finite (callers then fall back to another method).
+    pub(crate) fn covariance(&self) -> Option<Sym3> {
+        let w = self.weight;
+        if w.is_nan() || w <= 0.0 || w.is_infinite() {
+            return None;
+        }
+        let (first_scale, second_scale) = match self.kind {
+            Kind::Area => (1.0 / (3.0 * w), 1.0 / (12.0 * w)),
+            Kind::Points => (1.0 / w, 1.0 / w),
+            Kind::Empty => return None,
+        };
+        let m = self.first.map(|v| v * first_scale);
+        let s = self.second.map(|v| v * second_scale);
+        let c = Sym3([
+            s[0] - m[0] * m[0],
+            s[1] - m[1] * m[1],
+            s[2] - m[2] * m[2],
+            s[3] - m[0] * m[1],
+            s[4] - m[0] * m[2],
+            s[5] - m[1] * m[2],
+        ]);
+        c.is_finite().then_some(c)
+    }
+}

@@ -1,0 +1,214 @@
+//! The fit itself: from a face set to its principal-axes frame, per [`FitMethod`].
+//!
+//! Steps: gather the distinct vertices; classify their intrinsic dimension (points and
+//! lines have fixed answers); accumulate the method's covariance — in the plane, with
+//! the plane normal as the last axis, for coplanar sets; diagonalise; choose axes inside
+//! any tied eigenspace; normalise signs and handedness. Failures fall back along
+//! hull → triangles → vertices, never to an unchecked result.
+
+use nalgebra::Matrix3;
+
+use super::covariance::{Moments, Sym3};
+use super::dimension::{classify, Shape};
+use super::eigen::{axes2, axes3};
+use super::frame::{finish, Frame};
+use super::hull::{is_flat, plane_basis};
+use super::scratch::Scratch;
+use super::symmetry::{refine, LargestTriangles};
+use super::vec3::{sub, V3};
+use super::FitMethod;
+
+/// Where the covariance came from; the same triangles propose axes for tied eigenvalues.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    /// The 3-D hull triangles in `Scratch::hull.tris`.
+    HullSolid,
+    /// The 2-D hull polygon in `Scratch::hull.poly`.
+    HullFlat,
+    /// The input faces.
+    Faces,
+}
+
+/// The frame of `faces` by `method`; see `super::principal_axes` for the contract.
+pub(crate) fn fit(
+    s: &mut Scratch,
+    method: FitMethod,
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+) -> Matrix3<f64> {
+    let mut method = method;
+    // The triangle covariance decides, by its area, whether the method applies at all,
+    // and the vertex method needs welded points: settle the method before gathering.
+    let mut tri_cov = None;
+    if method == FitMethod::Triangles {
+        tri_cov = triangle_covariance(positions, faces);
+        if tri_cov.is_none() {
+            method = FitMethod::Vertices;
+        }
+    }
+    s.gather(positions, faces, method == FitMethod::Vertices);
+    let shape = classify(&s.pts, s.magnitude);
+    match shape.dim {
+        0 => return Matrix3::identity(),
+        1 => {
+            let (c0, c1) = Frame::FreeAfter {
+                c0: shape.direction,
+            }
+            .default_columns();
+            return finish(c0, c1);
+        }
+        _ => {}
+    }
+
+    let mut result = None;
+    if method == FitMethod::Hull {
+        result = hull_frame(s, &shape);
+        if result.is_none() {
+            tri_cov = triangle_covariance(positions, faces);
+        }
+    }
+    if result.is_none() {
+        if let Some(c) = tri_cov {
+            result = cov_frame(&c, &shape).map(|f| (f, Source::Faces));
+        }
+    }
+    if result.is_none() {
+        // The vertex covariance; on the hull/triangle fallback path the points are not
+        // welded, which only reweights duplicated positions.
+        let mut m = Moments::default();
+        for &p in &s.pts {
+            m.add_point(p);
+        }
+        result = m
+            .covariance()
+            .and_then(|c| cov_frame(&c, &shape))
+            .map(|f| (f, Source::Faces));
+    }
+    let Some((frame, source)) = result else {
+        return Matrix3::identity();
+    };
+
+    let (c0, c1) = if frame.is_free() {
+        let tris = largest_triangles(s, source, positions, faces);
+        refine(&frame, &s.pts, &tris)
+    } else {
+        frame.default_columns()
+    };
+    finish(c0, c1)
+}
+
+/// Area covariance of the hull surface (3-D) or polygon (flat), or `None` on failure.
+fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Frame, Source)> {
+    if is_flat(shape) {
+        s.hull.polygon(&s.pts, shape);
+        let poly = &s.hull.poly;
+        let plane = &s.hull.plane;
+        let at = |i: u32| {
+            plane
+                .get(i as usize)
+                .map(|q| [q[0], q[1], 0.0])
+                .unwrap_or([0.0; 3])
+        };
+        let (&first, rest) = poly.split_first()?;
+        let mut m = Moments::default();
+        for w in rest.windows(2) {
+            m.add_triangle(at(first), at(w[0]), at(w[1]));
+        }
+        let c = m.covariance()?;
+        let (u, v, n) = plane_basis(shape);
+        let [xx, yy, _, xy, _, _] = c.0;
+        let frame = axes2(xx, xy, yy, u, v, n)?;
+        Some((frame, Source::HullFlat))
+    } else {
+        s.hull.polyhedron(&s.pts, shape).ok()?;
+        let pts = &s.pts;
+        let mut m = Moments::default();
+        for t in &s.hull.tris {
+            let (p, q, r) = (
+                pts.get(t[0] as usize)?,
+                pts.get(t[1] as usize)?,
+                pts.get(t[2] as usize)?,
+            );
+            m.add_triangle(*p, *q, *r);
+        }
+        let c = m.covariance()?;
+        Some((axes3(&c)?, Source::HullSolid))
+    }
+}
+
+/// Area covariance of the given faces, or `None` when their total area is zero.
+fn triangle_covariance(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Option<Sym3> {
+    // Coordinates relative to one of the vertices keep the moment sums small.
+    let origin = faces
+        .iter()
+        .find_map(|f| positions.get(f[0] as usize))
+        .copied()?;
+    let mut m = Moments::default();
+    for f in faces {
+        if let (Some(&p), Some(&q), Some(&r)) = (
+            positions.get(f[0] as usize),
+            positions.get(f[1] as usize),
+            positions.get(f[2] as usize),
+        ) {
+            m.add_triangle(sub(p, origin), sub(q, origin), sub(r, origin));
+        }
+    }
+    if m.weight() > 0.0 {
+        m.covariance()
+    } else {
+        None
+    }
+}
+
+/// Principal axes of covariance `c`: in the plane for coplanar sets (normal last), else
+/// of the full matrix.
+fn cov_frame(c: &Sym3, shape: &Shape) -> Option<Frame> {
+    if shape.dim == 2 {
+        let (u, v, n) = plane_basis(shape);
+        axes2(c.form(u, u), c.form(u, v), c.form(v, v), u, v, n)
+    } else {
+        axes3(c)
+    }
+}
+
+/// The largest triangles of the covariance's source, to propose axes for tied
+/// eigenvalues.
+fn largest_triangles(
+    s: &Scratch,
+    source: Source,
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+) -> LargestTriangles {
+    let mut best = LargestTriangles::default();
+    let pt = |i: u32| -> Option<V3> { s.pts.get(i as usize).copied() };
+    match source {
+        Source::HullSolid => {
+            for t in &s.hull.tris {
+                if let (Some(p), Some(q), Some(r)) = (pt(t[0]), pt(t[1]), pt(t[2])) {
+                    best.offer(p, q, r);
+                }
+            }
+        }
+        Source::HullFlat => {
+            if let Some((&first, rest)) = s.hull.poly.split_first() {
+                for w in rest.windows(2) {
+                    if let (Some(p), Some(q), Some(r)) = (pt(first), pt(w[0]), pt(w[1])) {
+                        best.offer(p, q, r);
+                    }
+                }
+            }
+        }
+        Source::Faces => {
+            for f in faces {
+                if let (Some(&p), Some(&q), Some(&r)) = (
+                    positions.get(f[0] as usize),
+                    positions.get(f[1] as usize),
+                    positions.get(f[2] as usize),
+                ) {
+                    best.offer(p, q, r);
+                }
+            }
+        }
+    }
+    best
+}
