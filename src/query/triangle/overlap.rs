@@ -1,0 +1,406 @@
+//! Exact contact test between two closed triangles (Guigue–Devillers on exact orient3d, with
+//! explicit coplanar and degenerate branches built on the same exact predicates).
+
+use super::predicates::{
+    dominant_axis, in_range, max_abs, orient2d, orient3d, project, rescale, PlaneSide, P2,
+};
+use super::Triangle;
+use nalgebra::Vector3;
+
+type V = Vector3<f64>;
+
+/// Do two closed triangles share at least one point?
+///
+/// **Contact rule: closed sets; exact on the given coordinates.** Each triangle is the closed
+/// set of all convex combinations of its three corners (interior, edges and corners). The
+/// answer is `true` iff the two sets share at least one point: crossing, coplanar overlap, a
+/// shared corner or edge, a corner lying on the other triangle, a single touching point. A
+/// zero-area triangle is the segment or point its corners span and follows the same rule.
+///
+/// The decision uses only the signs of orientation determinants (orient3d, and orient2d on
+/// exact coordinate projections), evaluated exactly with Shewchuk's adaptive arithmetic, so it
+/// is the exact answer for the f64 coordinates given (no tolerance). Pairs whose largest
+/// coordinate lies outside 1e-60..1e60 are first scaled by a power of two (exact), so the
+/// answer stays exact unless the coordinates span hundreds of orders of magnitude. It never
+/// panics and needs no allocation.
+///
+/// Cost: an exact bounding-box rejection, then the three corners of `b` against the plane of
+/// `a` (early out when all lie strictly on one side), then the corners of `a` against the plane
+/// of `b`, then Guigue–Devillers' two interval checks. The side tests share each plane's cross
+/// product and use Shewchuk's static error bound, falling back to exact arithmetic only when a
+/// sign is too close to call.
+#[inline]
+pub fn triangles_intersect(a: &Triangle, b: &Triangle) -> bool {
+    if !aabb_overlap(a, b) {
+        return false;
+    }
+    let m = max_abs(a, b);
+    if !in_range(m) {
+        let (a, b, _) = rescale(a, b, m);
+        return triangles_intersect(&a, &b);
+    }
+    let pa = PlaneSide::new(a);
+    // Signs of b's corners against a's plane: early out when all strictly on one side.
+    let db = [0, 1, 2].map(|j| pa.side(a, &b[j]));
+    if strictly_one_side(&db) {
+        return false;
+    }
+    let pb = PlaneSide::new(b);
+    intersect_after_a_plane(a, b, &pb, db)
+}
+
+/// [`triangles_intersect`] for callers that already have both planes and know the bounding
+/// boxes overlap.
+#[inline]
+pub(crate) fn intersect_with_planes(
+    a: &Triangle,
+    b: &Triangle,
+    pa: &PlaneSide,
+    pb: &PlaneSide,
+) -> bool {
+    let db = [0, 1, 2].map(|j| pa.side(a, &b[j]));
+    if strictly_one_side(&db) {
+        return false;
+    }
+    intersect_after_a_plane(a, b, pb, db)
+}
+
+/// `db[j]`: exact-sign side of `b[j]` against a's plane (not all of one strict sign).
+#[inline(always)]
+fn intersect_after_a_plane(a: &Triangle, b: &Triangle, pb: &PlaneSide, db: [f64; 3]) -> bool {
+    let da = [0, 1, 2].map(|i| pb.side(b, &a[i]));
+    if strictly_one_side(&da) {
+        return false;
+    }
+    let db_zero = db == [0.0; 3];
+    let da_zero = da == [0.0; 3];
+    if !db_zero && !da_zero {
+        // Both triangles are non-degenerate (a degenerate triangle makes every side test
+        // against its plane vanish) and not coplanar: the general case.
+        return guigue_devillers(a, b, da, db);
+    }
+    special_cases(a, b, &da, &db, da_zero, db_zero)
+}
+
+/// Exact and necessary: closed sets that share a point have overlapping closed boxes.
+#[inline(always)]
+pub(crate) fn aabb_overlap(a: &Triangle, b: &Triangle) -> bool {
+    for k in 0..3 {
+        let amin = a[0][k].min(a[1][k]).min(a[2][k]);
+        let amax = a[0][k].max(a[1][k]).max(a[2][k]);
+        let bmin = b[0][k].min(b[1][k]).min(b[2][k]);
+        let bmax = b[0][k].max(b[1][k]).max(b[2][k]);
+        if amax < bmin || bmax < amin {
+            return false;
+        }
+    }
+    true
+}
+
+#[inline(always)]
+fn strictly_one_side(d: &[f64; 3]) -> bool {
+    (d[0] > 0.0 && d[1] > 0.0 && d[2] > 0.0) || (d[0] < 0.0 && d[1] < 0.0 && d[2] < 0.0)
+}
+
+/// Guigue–Devillers' orientation `[a, b, c, d] = (d - c) · ((a - c) × (b - c))`, the opposite
+/// of Shewchuk's orient3d. Exact sign.
+#[inline(always)]
+fn gd(a: &V, b: &V, c: &V, d: &V) -> f64 {
+    -orient3d(a, b, c, d)
+}
+
+/// The non-coplanar, non-degenerate case. `d1[i] = gd(b0, b1, b2, a_i)`,
+/// `d2[j] = gd(a0, a1, a2, b_j)` (what [`PlaneSide::side`] computes); neither is all zero nor
+/// all of one strict sign.
+/// Transcription of Guigue & Devillers (JGT 8(1), 2003) `tri_tri_overlap_test_3d` with closed
+/// comparisons (touching counts as contact).
+#[inline]
+fn guigue_devillers(a: &Triangle, b: &Triangle, d1: [f64; 3], d2: [f64; 3]) -> bool {
+    let (p1, q1, r1) = (&a[0], &a[1], &a[2]);
+    let (p2, q2, r2) = (&b[0], &b[1], &b[2]);
+    let [dp1, dq1, dr1] = d1;
+    let [dp2, dq2, dr2] = d2;
+    // Permute a so that its first corner is alone on its side of b's plane (swapping b's
+    // orientation when that side is the negative one).
+    if dp1 > 0.0 {
+        if dq1 > 0.0 {
+            tri_tri_3d(r1, p1, q1, p2, r2, q2, dp2, dr2, dq2, a, b)
+        } else if dr1 > 0.0 {
+            tri_tri_3d(q1, r1, p1, p2, r2, q2, dp2, dr2, dq2, a, b)
+        } else {
+            tri_tri_3d(p1, q1, r1, p2, q2, r2, dp2, dq2, dr2, a, b)
+        }
+    } else if dp1 < 0.0 {
+        if dq1 < 0.0 {
+            tri_tri_3d(r1, p1, q1, p2, q2, r2, dp2, dq2, dr2, a, b)
+        } else if dr1 < 0.0 {
+            tri_tri_3d(q1, r1, p1, p2, q2, r2, dp2, dq2, dr2, a, b)
+        } else {
+            tri_tri_3d(p1, q1, r1, p2, r2, q2, dp2, dr2, dq2, a, b)
+        }
+    } else if dq1 < 0.0 {
+        if dr1 >= 0.0 {
+            tri_tri_3d(q1, r1, p1, p2, r2, q2, dp2, dr2, dq2, a, b)
+        } else {
+            tri_tri_3d(p1, q1, r1, p2, q2, r2, dp2, dq2, dr2, a, b)
+        }
+    } else if dq1 > 0.0 {
+        if dr1 > 0.0 {
+            tri_tri_3d(p1, q1, r1, p2, r2, q2, dp2, dr2, dq2, a, b)
+        } else {
+            tri_tri_3d(q1, r1, p1, p2, q2, r2, dp2, dq2, dr2, a, b)
+        }
+    } else if dr1 > 0.0 {
+        tri_tri_3d(r1, p1, q1, p2, q2, r2, dp2, dq2, dr2, a, b)
+    } else if dr1 < 0.0 {
+        tri_tri_3d(r1, p1, q1, p2, r2, q2, dp2, dr2, dq2, a, b)
+    } else {
+        // Unreachable (d1 is not all zero); decided exactly anyway.
+        coplanar(a, b)
+    }
+}
+
+/// Permutes b into canonical form, then checks the overlap of the two intervals that the
+/// triangles cut on the line common to their planes.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn tri_tri_3d(
+    p1: &V,
+    q1: &V,
+    r1: &V,
+    p2: &V,
+    q2: &V,
+    r2: &V,
+    dp2: f64,
+    dq2: f64,
+    dr2: f64,
+    a: &Triangle,
+    b: &Triangle,
+) -> bool {
+    if dp2 > 0.0 {
+        if dq2 > 0.0 {
+            check_min_max(p1, r1, q1, r2, p2, q2)
+        } else if dr2 > 0.0 {
+            check_min_max(p1, r1, q1, q2, r2, p2)
+        } else {
+            check_min_max(p1, q1, r1, p2, q2, r2)
+        }
+    } else if dp2 < 0.0 {
+        if dq2 < 0.0 {
+            check_min_max(p1, q1, r1, r2, p2, q2)
+        } else if dr2 < 0.0 {
+            check_min_max(p1, q1, r1, q2, r2, p2)
+        } else {
+            check_min_max(p1, r1, q1, p2, q2, r2)
+        }
+    } else if dq2 < 0.0 {
+        if dr2 >= 0.0 {
+            check_min_max(p1, r1, q1, q2, r2, p2)
+        } else {
+            check_min_max(p1, q1, r1, p2, q2, r2)
+        }
+    } else if dq2 > 0.0 {
+        if dr2 > 0.0 {
+            check_min_max(p1, r1, q1, p2, q2, r2)
+        } else {
+            check_min_max(p1, q1, r1, q2, r2, p2)
+        }
+    } else if dr2 > 0.0 {
+        check_min_max(p1, q1, r1, r2, p2, q2)
+    } else if dr2 < 0.0 {
+        check_min_max(p1, r1, q1, r2, p2, q2)
+    } else {
+        // Unreachable (d2 is not all zero); decided exactly anyway.
+        coplanar(a, b)
+    }
+}
+
+/// The intervals overlap iff neither lies strictly beyond the other (closed comparison).
+#[inline(always)]
+fn check_min_max(p1: &V, q1: &V, r1: &V, p2: &V, q2: &V, r2: &V) -> bool {
+    if gd(p2, p1, q1, q2) > 0.0 {
+        return false;
+    }
+    gd(p2, r1, p1, r2) <= 0.0
+}
+
+/// Everything that is not the general case: coplanar triangles, and degenerate (segment or
+/// point) triangles. Rare, so written for clarity with exact predicates throughout.
+#[cold]
+#[inline(never)]
+fn special_cases(
+    a: &Triangle,
+    b: &Triangle,
+    da: &[f64; 3],
+    db: &[f64; 3],
+    da_zero: bool,
+    db_zero: bool,
+) -> bool {
+    if db_zero {
+        if let Some(axis) = dominant_axis(a) {
+            // a is a proper triangle and b lies in its plane.
+            return tri_tri_2d(&project3(a, axis), &project3(b, axis));
+        }
+    }
+    if da_zero {
+        if let Some(axis) = dominant_axis(b) {
+            return tri_tri_2d(&project3(a, axis), &project3(b, axis));
+        }
+    }
+    // Now every triangle whose orientations all vanish is degenerate.
+    match (da_zero, db_zero) {
+        // a degenerate (db all zero), b proper and a not in b's plane.
+        (false, true) => line_crosses_triangle(a, da, b),
+        (true, false) => line_crosses_triangle(b, db, a),
+        // Both degenerate: segments or points.
+        (true, true) => degenerate_pair(a, b),
+        // Excluded by the caller; answer exactly all the same.
+        (false, false) => coplanar(a, b) || guigue_devillers(a, b, *da, *db),
+    }
+}
+
+/// Fallback for a coplanar pair: project along a direction that is injective on the plane.
+fn coplanar(a: &Triangle, b: &Triangle) -> bool {
+    match dominant_axis(a).or_else(|| dominant_axis(b)) {
+        Some(axis) => tri_tri_2d(&project3(a, axis), &project3(b, axis)),
+        None => degenerate_pair(a, b),
+    }
+}
+
+/// `s` is a degenerate triangle (its corners collinear, not all equal) that is not in the plane
+/// of the proper triangle `t`; `ds[i]` is the exact-sign orientation of `s[i]` against `t`'s
+/// plane, not all of one strict sign. Two corners of different side classes span the line of
+/// `s`, and the segment between them contains the single point where that line meets the
+/// plane; `s` touches `t` iff that point is in `t`, i.e. iff the line passes through the closed
+/// triangle: the three line–edge orientations are not of both strict signs.
+fn line_crosses_triangle(s: &Triangle, ds: &[f64; 3], t: &Triangle) -> bool {
+    let class = |x: f64| (x > 0.0) as i8 - (x < 0.0) as i8;
+    let mut pair = None;
+    'outer: for i in 0..3 {
+        for j in i + 1..3 {
+            if class(ds[i]) != class(ds[j]) {
+                pair = Some((i, j));
+                break 'outer;
+            }
+        }
+    }
+    let Some((i, j)) = pair else {
+        return false; // all strictly on one side (excluded by the caller)
+    };
+    let (p, q) = (&s[i], &s[j]);
+    let o = [
+        orient3d(p, q, &t[0], &t[1]),
+        orient3d(p, q, &t[1], &t[2]),
+        orient3d(p, q, &t[2], &t[0]),
+    ];
+    !(o.iter().any(|&x| x > 0.0) && o.iter().any(|&x| x < 0.0))
+}
+
+/// Two degenerate triangles (segments or points). They can only meet if their spans are
+/// coplanar; then the three coordinate projections all intersect iff the sets do (one of them
+/// is injective on the common plane or line, and any common point projects to a common point).
+fn degenerate_pair(a: &Triangle, b: &Triangle) -> bool {
+    if let (Some((p, q)), Some((r, s))) = (distinct_pair(a), distinct_pair(b)) {
+        if orient3d(p, q, r, s) != 0.0 {
+            return false; // skew lines
+        }
+    }
+    (0..3).all(|axis| tri_tri_2d(&project3(a, axis), &project3(b, axis)))
+}
+
+/// Two distinct corners of `t`, if any.
+fn distinct_pair(t: &Triangle) -> Option<(&V, &V)> {
+    if t[1] != t[0] {
+        Some((&t[0], &t[1]))
+    } else if t[2] != t[0] {
+        Some((&t[0], &t[2]))
+    } else {
+        None
+    }
+}
+
+fn project3(t: &Triangle, axis: usize) -> [P2; 3] {
+    [
+        project(&t[0], axis),
+        project(&t[1], axis),
+        project(&t[2], axis),
+    ]
+}
+
+/// Closed 2D triangles (possibly degenerate) intersect iff an edge of one meets an edge of the
+/// other, or one contains a corner of the other (containment without boundary contact).
+pub(crate) fn tri_tri_2d(a: &[P2; 3], b: &[P2; 3]) -> bool {
+    for i in 0..3 {
+        let (p, q) = (a[i], a[(i + 1) % 3]);
+        for j in 0..3 {
+            if seg_seg_2d(p, q, b[j], b[(j + 1) % 3]) {
+                return true;
+            }
+        }
+    }
+    point_in_tri_2d(a[0], b) || point_in_tri_2d(b[0], a)
+}
+
+#[inline]
+fn same_strict(x: f64, y: f64) -> bool {
+    (x > 0.0 && y > 0.0) || (x < 0.0 && y < 0.0)
+}
+
+/// Closed segments `pq` and `rs` (either may be a point) share a point. Exact.
+pub(crate) fn seg_seg_2d(p: P2, q: P2, r: P2, s: P2) -> bool {
+    let o1 = orient2d(p, q, r);
+    let o2 = orient2d(p, q, s);
+    if same_strict(o1, o2) {
+        return false;
+    }
+    let o3 = orient2d(r, s, p);
+    let o4 = orient2d(r, s, q);
+    if same_strict(o3, o4) {
+        return false;
+    }
+    if o1 == 0.0 && o2 == 0.0 && o3 == 0.0 && o4 == 0.0 {
+        // All on one line (or points): the sets meet iff their bounding boxes do.
+        return (0..2)
+            .all(|k| p[k].max(q[k]) >= r[k].min(s[k]) && r[k].max(s[k]) >= p[k].min(q[k]));
+    }
+    true
+}
+
+/// `p` lies in the closed, proper triangle `t`; `false` for a degenerate `t` (its edges cover
+/// it and are tested separately).
+pub(crate) fn point_in_tri_2d(p: P2, t: &[P2; 3]) -> bool {
+    if orient2d(t[0], t[1], t[2]) == 0.0 {
+        return false;
+    }
+    let s = [
+        orient2d(t[0], t[1], p),
+        orient2d(t[1], t[2], p),
+        orient2d(t[2], t[0], p),
+    ];
+    !(s.iter().any(|&x| x > 0.0) && s.iter().any(|&x| x < 0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seg_seg_2d_cases() {
+        assert!(seg_seg_2d([0., 0.], [2., 2.], [0., 2.], [2., 0.]));
+        assert!(seg_seg_2d([0., 0.], [1., 1.], [1., 1.], [2., 0.]));
+        assert!(!seg_seg_2d([0., 0.], [1., 1.], [2., 2.], [3., 3.]));
+        assert!(seg_seg_2d([0., 0.], [2., 2.], [1., 1.], [3., 3.]));
+        assert!(seg_seg_2d([1., 1.], [1., 1.], [0., 0.], [2., 2.]));
+        assert!(!seg_seg_2d([1., 1.], [1., 1.], [2., 2.], [2., 2.]));
+        assert!(seg_seg_2d([1., 1.], [1., 1.], [1., 1.], [1., 1.]));
+    }
+
+    #[test]
+    fn point_in_tri_2d_cases() {
+        let t = [[0., 0.], [4., 0.], [0., 4.]];
+        assert!(point_in_tri_2d([1., 1.], &t));
+        assert!(point_in_tri_2d([2., 2.], &t));
+        assert!(point_in_tri_2d([0., 0.], &t));
+        assert!(!point_in_tri_2d([2.5, 2.], &t));
+    }
+}

@@ -1,0 +1,276 @@
+//! Exact orientation predicates on f64 coordinates (Shewchuk's adaptive orient2d / orient3d).
+//!
+//! `orient3d` evaluates Shewchuk's static error filter inline (the same expression, in the same
+//! order, as `robust::orient3d`, so the same error bound holds) and only calls the adaptive,
+//! exact routine of the `robust` crate when the filter cannot certify the sign. The sign of the
+//! result is exact (barring overflow or underflow of the intermediate products); its magnitude
+//! is only an approximation of the determinant.
+
+use nalgebra::Vector3;
+use robust::{Coord, Coord3D};
+
+type V = Vector3<f64>;
+
+/// Half the f64 machine epsilon (2^-53), Shewchuk's `epsilon`.
+const EPS: f64 = f64::EPSILON * 0.5;
+/// Shewchuk's `o3derrboundA`.
+const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * EPS) * EPS;
+
+/// Shewchuk's orient3d: positive when `d` lies below the plane through `a`, `b`, `c` (the side
+/// from which `a`, `b`, `c` appear clockwise), negative above, exactly zero iff the four points
+/// are coplanar. Equals `det[a - d, b - d, c - d]` in sign.
+#[inline(always)]
+pub(crate) fn orient3d(a: &V, b: &V, c: &V, d: &V) -> f64 {
+    let adx = a.x - d.x;
+    let bdx = b.x - d.x;
+    let cdx = c.x - d.x;
+    let ady = a.y - d.y;
+    let bdy = b.y - d.y;
+    let cdy = c.y - d.y;
+    let adz = a.z - d.z;
+    let bdz = b.z - d.z;
+    let cdz = c.z - d.z;
+
+    let bdxcdy = bdx * cdy;
+    let cdxbdy = cdx * bdy;
+    let cdxady = cdx * ady;
+    let adxcdy = adx * cdy;
+    let adxbdy = adx * bdy;
+    let bdxady = bdx * ady;
+
+    let det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
+    let errbound = O3D_ERRBOUND_A * permanent;
+    if det > errbound || -det > errbound {
+        return det;
+    }
+    orient3d_adaptive(a, b, c, d)
+}
+
+#[cold]
+#[inline(never)]
+fn orient3d_adaptive(a: &V, b: &V, c: &V, d: &V) -> f64 {
+    let p = |v: &V| Coord3D {
+        x: v.x,
+        y: v.y,
+        z: v.z,
+    };
+    robust::orient3d(p(a), p(b), p(c), p(d))
+}
+
+/// A triangle's supporting plane, prepared for many exact side tests.
+///
+/// `side(x)` evaluates `(x - t0) · ((t1 - t0) × (t2 - t0))`, Guigue–Devillers' `[t0, t1, t2, x]`
+/// and the negation of Shewchuk's `orient3d(t0, t1, t2, x)`, with the cross product shared
+/// between calls. It is Shewchuk's stage-A expression for the transposed matrix (each of the
+/// nine entries one rounded difference of inputs, each term an entry times a difference of two
+/// products, summed left to right), so his stage-A error bound applies to it unchanged; when
+/// it cannot certify the sign the adaptive exact routine decides.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PlaneSide {
+    /// `t1 - t0` and `t2 - t0`.
+    pub e1: V,
+    pub e2: V,
+    /// `e1 × e2`, each component a difference of two products.
+    pub n: V,
+    /// Per component, the sum of the absolute values of those two products.
+    nabs: V,
+}
+
+impl PlaneSide {
+    #[inline(always)]
+    pub fn new(t: &[V; 3]) -> Self {
+        let e1 = t[1] - t[0];
+        let e2 = t[2] - t[0];
+        let (p1, q1) = (e1.y * e2.z, e1.z * e2.y);
+        let (p2, q2) = (e1.z * e2.x, e1.x * e2.z);
+        let (p3, q3) = (e1.x * e2.y, e1.y * e2.x);
+        PlaneSide {
+            e1,
+            e2,
+            n: V::new(p1 - q1, p2 - q2, p3 - q3),
+            nabs: V::new(
+                p1.abs() + q1.abs(),
+                p2.abs() + q2.abs(),
+                p3.abs() + q3.abs(),
+            ),
+        }
+    }
+
+    /// Exact sign of `(x - t0) · n` (approximate magnitude); `t` is the triangle this plane
+    /// was made from.
+    #[inline(always)]
+    pub fn side(&self, t: &[V; 3], x: &V) -> f64 {
+        let d = x - t[0];
+        let det = d.x * self.n.x + d.y * self.n.y + d.z * self.n.z;
+        let permanent = d.x.abs() * self.nabs.x + d.y.abs() * self.nabs.y + d.z.abs() * self.nabs.z;
+        let errbound = O3D_ERRBOUND_A * permanent;
+        if det > errbound || -det > errbound {
+            return det;
+        }
+        -orient3d_adaptive(&t[0], &t[1], &t[2], x)
+    }
+}
+
+/// Coordinates whose largest magnitude lies in `[RANGE_LO, RANGE_HI]` (or are all zero) keep
+/// every product the predicates and distance formulas form (up to fourth powers of coordinate
+/// differences, and the tails of Shewchuk's expansions) clear of overflow and underflow.
+const RANGE_LO: f64 = 1e-60;
+const RANGE_HI: f64 = 1e60;
+
+/// The largest coordinate magnitude of two triangles.
+#[inline(always)]
+pub(crate) fn max_abs(a: &[V; 3], b: &[V; 3]) -> f64 {
+    let mut m = 0.0f64;
+    for p in a.iter().chain(b.iter()) {
+        m = m.max(p.x.abs()).max(p.y.abs()).max(p.z.abs());
+    }
+    m
+}
+
+/// Is `max_abs` inside the safe range (see [`rescale`] otherwise)?
+#[inline(always)]
+pub(crate) fn in_range(m: f64) -> bool {
+    (RANGE_LO..=RANGE_HI).contains(&m) || m == 0.0
+}
+
+/// `2^k` for `k` in `-1022..=1023`.
+fn pow2(k: i32) -> f64 {
+    f64::from_bits(((k.clamp(-1022, 1023) + 1023) as u64) << 52)
+}
+
+/// Scales both triangles by the power of two `2^-e` that brings `m = max_abs(a, b)` into
+/// `[1, 2)`, and returns them with `2^e` to scale lengths back. Scaling by a power of two is
+/// exact (the contact answer is unchanged) unless it pushes some coordinate below the normal
+/// range, which only happens for pairs whose coordinates span hundreds of orders of magnitude.
+#[cold]
+pub(crate) fn rescale(a: &[V; 3], b: &[V; 3], m: f64) -> ([V; 3], [V; 3], f64) {
+    let e = if m > 0.0 { m.log2().floor() as i32 } else { 0 };
+    // Two factors so that each stays representable (e can reach -1074).
+    let (h1, h2) = (-e / 2, -e - (-e / 2));
+    let (f1, f2) = (pow2(h1), pow2(h2));
+    let scale = |t: &[V; 3]| t.map(|p| p * f1 * f2);
+    (scale(a), scale(b), pow2(e / 2) * pow2(e - e / 2))
+}
+
+/// A point of a coordinate plane: two of the three coordinates of a 3D point, taken exactly.
+pub(crate) type P2 = [f64; 2];
+
+/// Shewchuk's orient2d: positive when `a`, `b`, `c` turn counterclockwise, negative clockwise,
+/// exactly zero iff collinear.
+#[inline]
+pub(crate) fn orient2d(a: P2, b: P2, c: P2) -> f64 {
+    robust::orient2d(
+        Coord { x: a[0], y: a[1] },
+        Coord { x: b[0], y: b[1] },
+        Coord { x: c[0], y: c[1] },
+    )
+}
+
+/// The coordinates kept when projecting along `axis` (0 = x, 1 = y, 2 = z): the projection
+/// is exact, it just drops one coordinate.
+#[inline]
+pub(crate) fn project(v: &V, axis: usize) -> P2 {
+    match axis {
+        0 => [v.y, v.z],
+        1 => [v.z, v.x],
+        _ => [v.x, v.y],
+    }
+}
+
+/// Exact-sign components of the normal `(b - a) × (c - a)`: component `k` is the orientation of
+/// the triangle projected along axis `k` (with the coordinate order of [`project`]).
+#[inline]
+pub(crate) fn normal_signs(a: &V, b: &V, c: &V) -> [f64; 3] {
+    [0, 1, 2].map(|k| orient2d(project(a, k), project(b, k), project(c, k)))
+}
+
+/// The axis along which a non-degenerate triangle projects with the largest area, or `None`
+/// when its corners are exactly collinear (or coincide). Projecting along the returned axis is
+/// injective on the triangle's plane.
+#[inline]
+pub(crate) fn dominant_axis(t: &[V; 3]) -> Option<usize> {
+    let n = normal_signs(&t[0], &t[1], &t[2]);
+    let mut best = None;
+    let mut best_abs = 0.0;
+    for (k, v) in n.iter().enumerate() {
+        if v.abs() > best_abs {
+            best_abs = v.abs();
+            best = Some(k);
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn filter_agrees_with_robust() {
+        let pts = [
+            V::new(0.0, 0.0, 0.0),
+            V::new(1.0, 0.0, 0.0),
+            V::new(0.0, 1.0, 0.0),
+            V::new(0.1, 0.1, 1e-300),
+            V::new(0.1, 0.1, 0.0),
+            V::new(1e6 + 0.1, 3.0, -2.0),
+        ];
+        for a in &pts {
+            for b in &pts {
+                for c in &pts {
+                    for d in &pts {
+                        let p = |v: &V| Coord3D {
+                            x: v.x,
+                            y: v.y,
+                            z: v.z,
+                        };
+                        let r = robust::orient3d(p(a), p(b), p(c), p(d));
+                        let o = orient3d(a, b, c, d);
+                        assert_eq!(r.partial_cmp(&0.0), o.partial_cmp(&0.0));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn plane_side_is_negated_orient3d() {
+        let pts = [
+            V::new(0.0, 0.0, 0.0),
+            V::new(1.0, 0.0, 0.0),
+            V::new(0.0, 1.0, 0.0),
+            V::new(0.1, 0.1, 1e-300),
+            V::new(0.1, 0.1, 0.0),
+            V::new(1e6 + 0.1, 3.0, -2.0),
+            V::new(0.3, 0.7, 0.0),
+            V::new(1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0),
+        ];
+        for a in &pts {
+            for b in &pts {
+                for c in &pts {
+                    let t = [*a, *b, *c];
+                    let plane = PlaneSide::new(&t);
+                    for d in &pts {
+                        let o = -orient3d(a, b, c, d);
+                        let s = plane.side(&t, d);
+                        assert_eq!(s.partial_cmp(&0.0), o.partial_cmp(&0.0), "{t:?} {d:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn orient3d_sign_convention() {
+        let o = V::zeros();
+        let x = V::x();
+        let y = V::y();
+        // d below the counterclockwise (seen from +z) plane → positive.
+        assert!(orient3d(&o, &x, &y, &V::new(0.2, 0.2, -1.0)) > 0.0);
+        assert!(orient3d(&o, &x, &y, &V::new(0.2, 0.2, 1.0)) < 0.0);
+        assert_eq!(orient3d(&o, &x, &y, &V::new(7.0, -3.0, 0.0)), 0.0);
+    }
+}
