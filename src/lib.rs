@@ -6,5 +6,6 @@ pub mod bv;
 pub mod fit;
 pub mod format;
 pub mod mesh;
+pub mod query;
 pub mod real;
 pub mod tree;

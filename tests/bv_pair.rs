@@ -27,8 +27,8 @@ fn obb(rot: Matrix3<f64>, c: Vector3<f64>, h: Vector3<f64>) -> Obb<f64> {
 /// Points of an OBB in its model frame at box coordinates `s` in [-1, 1]^3.
 fn point_of(b: &Obb<f64>, s: [f64; 3]) -> Vector3<f64> {
     let mut p = Vector3::from(b.center);
-    for i in 0..3 {
-        p += Vector3::from(b.axes[i]) * (s[i] * b.half[i]);
+    for ((axis, t), h) in b.axes.iter().zip(s).zip(b.half) {
+        p += Vector3::from(*axis) * (t * h);
     }
     p
 }

@@ -1,0 +1,130 @@
+//! Collision: every contacting triangle pair, or the first one found.
+
+use super::engine::{traverse, Flow, Policy, QueryContext};
+use super::triangle::{triangles_intersect, Triangle};
+use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
+use crate::bv::pair::{Transform, SAT_GUARD};
+use crate::bv::BoundingVolume;
+use crate::format::ObbtFile;
+use crate::tree::TreeView;
+
+/// How to run a collision query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CollideOptions {
+    /// Stop at the first contact (a yes/no answer with one witness pair).
+    pub first_contact: bool,
+    /// Which tree to descend when both can be.
+    pub rule: DescentRule,
+    /// Separating-axis guard (§4.5); keep the default [`SAT_GUARD`] outside experiments.
+    pub guard: f64,
+}
+
+impl Default for CollideOptions {
+    fn default() -> Self {
+        CollideOptions {
+            first_contact: false,
+            rule: DescentRule::default(),
+            guard: SAT_GUARD,
+        }
+    }
+}
+
+/// The answer of a collision query.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CollideResult {
+    /// Whether any triangle of A touches any triangle of B.
+    pub colliding: bool,
+    /// Contacting pairs as input-mesh ids `(id_a, id_b)`, sorted; one pair at most with
+    /// `first_contact`.
+    pub pairs: Vec<(u32, u32)>,
+    /// Work done.
+    pub stats: Stats,
+}
+
+struct Collide {
+    guard: f64,
+    first: bool,
+    faces: Vec<(u32, u32)>,
+}
+
+impl<B: BoundingVolume> Policy<B> for Collide {
+    const ORDERED: bool = false;
+
+    #[inline]
+    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64 {
+        if a.overlaps(b, xf, self.guard) {
+            0.0
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    #[inline]
+    fn keep(&self, key: f64) -> bool {
+        key == 0.0
+    }
+
+    #[inline]
+    fn triangles(
+        &mut self,
+        fa: u32,
+        a: &Triangle,
+        fb: u32,
+        b: &Triangle,
+        stats: &mut Stats,
+    ) -> Flow {
+        if triangles_intersect(a, b) {
+            stats.tri_contact += 1;
+            self.faces.push((fa, fb));
+            if self.first {
+                return Flow::Stop;
+            }
+        } else {
+            stats.tri_separated += 1;
+        }
+        Flow::Continue
+    }
+}
+
+/// All contacting triangle pairs of two posed trees (or the first found).
+pub fn collide<B: BoundingVolume>(
+    a: &TreeView<'_, B>,
+    pose_a: &Pose,
+    b: &TreeView<'_, B>,
+    pose_b: &Pose,
+    options: &CollideOptions,
+    context: &mut QueryContext,
+) -> Result<CollideResult, QueryError> {
+    let xf = Pose::relative(pose_a, pose_b);
+    let mut policy = Collide {
+        guard: options.guard,
+        first: options.first_contact,
+        faces: Vec::new(),
+    };
+    let stats = traverse(a, b, &xf, options.rule, &mut policy, context)?;
+    let mut pairs = policy
+        .faces
+        .iter()
+        .map(|&(fa, fb)| Ok((source_id(a, fa, 'A')?, source_id(b, fb, 'B')?)))
+        .collect::<Result<Vec<_>, QueryError>>()?;
+    pairs.sort_unstable();
+    Ok(CollideResult {
+        colliding: !pairs.is_empty(),
+        pairs,
+        stats,
+    })
+}
+
+/// [`collide`] on two files, dispatched once on their volume type and precision.
+pub fn collide_files(
+    a: &ObbtFile,
+    pose_a: &Pose,
+    b: &ObbtFile,
+    pose_b: &Pose,
+    options: &CollideOptions,
+    context: &mut QueryContext,
+) -> Result<CollideResult, QueryError> {
+    with_views!(a, b, |va, vb| collide(
+        &va, pose_a, &vb, pose_b, options, context
+    ))
+}

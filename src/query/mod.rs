@@ -1,0 +1,147 @@
+//! Queries between two posed trees: collision, separation distance, span.
+//!
+//! Models are triangle soups, that is surfaces: two models collide when their surfaces
+//! share a point, and the distance is 0 exactly then. A model wholly inside another does not
+//! collide with it (as in RAPID, PQP and FCL). Poses are f64 whatever the stored precision;
+//! triangle ids in every result are the input mesh's ids.
+//!
+//! ```no_run
+//! use obbtree::format::ObbtFile;
+//! use obbtree::query::{collide_files, CollideOptions, Pose, QueryContext};
+//!
+//! let a = ObbtFile::open("bunny.obbt")?;
+//! let b = ObbtFile::open("cow.obbt")?;
+//! let mut context = QueryContext::new();
+//! let result = collide_files(&a, &Pose::identity(), &b, &Pose::translation(0.1, 0.0, 0.0), &CollideOptions::default(), &mut context)?;
+//! println!("{} contacts, {:?}", result.pairs.len(), result.stats);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod collide;
+mod descent;
+mod distance;
+mod engine;
+mod pose;
+mod span;
+mod stats;
+pub mod triangle;
+
+pub use collide::{collide, collide_files, CollideOptions, CollideResult};
+pub use descent::DescentRule;
+pub use distance::{
+    distance, distance_files, within_tolerance, within_tolerance_files, DistanceOptions,
+    DistanceResult, ToleranceResult,
+};
+pub use engine::QueryContext;
+pub use pose::{Pose, PoseError, ORTHONORMAL_TOLERANCE};
+pub use span::{span, span_files, SpanResult};
+pub use stats::Stats;
+
+/// Why a query could not answer.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum QueryError {
+    /// The two trees store different volume types or precisions.
+    #[error("the trees differ in kind: A stores {a}, B stores {b}; build both with the same --bv and --precision")]
+    MismatchedTrees {
+        /// What A stores, e.g. `obb f32`.
+        a: String,
+        /// What B stores.
+        b: String,
+    },
+    /// A tree's contents are inconsistent (an unverified, corrupt file).
+    #[error("tree {which} is corrupt: {what} (run `obbtree verify`)")]
+    CorruptTree {
+        /// 'A' or 'B'.
+        which: char,
+        /// What was found.
+        what: &'static str,
+    },
+    /// An option value is out of range.
+    #[error("{name} must be {requirement}, got {value}")]
+    BadOption {
+        /// The option.
+        name: &'static str,
+        /// What it must be.
+        requirement: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A view of a tree could not be made.
+    #[error("{0}")]
+    Format(String),
+}
+
+/// Runs `$body` with `$va`, `$vb` bound to typed views of two files of the same volume type
+/// and precision: the one place a pair of files is dispatched on its header tags.
+macro_rules! with_views {
+    ($a:expr, $b:expr, |$va:ident, $vb:ident| $body:expr) => {{
+        use $crate::bv::{Aabb, BvKind, Obb, Sphere};
+        use $crate::real::Precision;
+        let (a, b) = ($a, $b);
+        if (a.bv_kind(), a.precision()) != (b.bv_kind(), b.precision()) {
+            return Err($crate::query::QueryError::MismatchedTrees {
+                a: format!("{} {}", a.bv_kind().name(), a.precision().name()),
+                b: format!("{} {}", b.bv_kind().name(), b.precision().name()),
+            });
+        }
+        let fmt = |e: $crate::format::FormatError| $crate::query::QueryError::Format(e.to_string());
+        match (a.bv_kind(), a.precision()) {
+            (BvKind::Obb, Precision::F32) => {
+                let ($va, $vb) = (
+                    a.view::<Obb<f32>>().map_err(fmt)?,
+                    b.view::<Obb<f32>>().map_err(fmt)?,
+                );
+                $body
+            }
+            (BvKind::Obb, Precision::F64) => {
+                let ($va, $vb) = (
+                    a.view::<Obb<f64>>().map_err(fmt)?,
+                    b.view::<Obb<f64>>().map_err(fmt)?,
+                );
+                $body
+            }
+            (BvKind::Aabb, Precision::F32) => {
+                let ($va, $vb) = (
+                    a.view::<Aabb<f32>>().map_err(fmt)?,
+                    b.view::<Aabb<f32>>().map_err(fmt)?,
+                );
+                $body
+            }
+            (BvKind::Aabb, Precision::F64) => {
+                let ($va, $vb) = (
+                    a.view::<Aabb<f64>>().map_err(fmt)?,
+                    b.view::<Aabb<f64>>().map_err(fmt)?,
+                );
+                $body
+            }
+            (BvKind::Sphere, Precision::F32) => {
+                let ($va, $vb) = (
+                    a.view::<Sphere<f32>>().map_err(fmt)?,
+                    b.view::<Sphere<f32>>().map_err(fmt)?,
+                );
+                $body
+            }
+            (BvKind::Sphere, Precision::F64) => {
+                let ($va, $vb) = (
+                    a.view::<Sphere<f64>>().map_err(fmt)?,
+                    b.view::<Sphere<f64>>().map_err(fmt)?,
+                );
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use with_views;
+
+/// The input-mesh id of leaf-ordered face `face`.
+pub(crate) fn source_id<B: crate::bv::BoundingVolume>(
+    tree: &crate::tree::TreeView<'_, B>,
+    face: u32,
+    which: char,
+) -> Result<u32, QueryError> {
+    tree.source_id(face).ok_or(QueryError::CorruptTree {
+        which,
+        what: "face index out of bounds",
+    })
+}

@@ -1,0 +1,30 @@
+//! Statistics every query returns (dissertation §2.5.1).
+
+/// Work done by one query.
+///
+/// For binary trees with single-face leaves and a traversal that runs to completion,
+/// `1 = D − I + 2S + 2K` (§2.5.1): every overlapping internal pair spawns two pair tests and
+/// every overlapping leaf pair one triangle test.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// D: bounding-volume pair tests that pruned the pair (disjoint, or too far / too near
+    /// to matter for a distance or span query).
+    pub bv_disjoint: u64,
+    /// I: bounding-volume pair tests that did not prune.
+    pub bv_overlap: u64,
+    /// S: triangle pair tests whose triangles do not touch.
+    pub tri_separated: u64,
+    /// K: triangle pair tests whose triangles touch.
+    pub tri_contact: u64,
+    /// Node pairs taken off the traversal stack (each reads one node of each tree).
+    pub nodes_visited: u64,
+}
+
+impl Stats {
+    /// `D − I + 2S + 2K`, which is 1 for a complete traversal of binary single-face trees.
+    pub fn identity_value(&self) -> i128 {
+        i128::from(self.bv_disjoint) - i128::from(self.bv_overlap)
+            + 2 * i128::from(self.tri_separated)
+            + 2 * i128::from(self.tri_contact)
+    }
+}
