@@ -4,6 +4,7 @@
 mod build;
 mod demo;
 mod info;
+mod query;
 mod verify;
 
 use clap::{Parser, Subcommand};
@@ -31,6 +32,9 @@ enum Command {
     Build(build::BuildArgs),
     Info(info::InfoArgs),
     Verify(verify::VerifyArgs),
+    Collide(query::CollideArgs),
+    Distance(query::DistanceArgs),
+    Span(query::SpanArgs),
     Demo(demo::DemoArgs),
 }
 
@@ -51,6 +55,9 @@ pub fn main() -> ExitCode {
         Command::Build(args) => build::run(&args),
         Command::Info(args) => info::run(&args),
         Command::Verify(args) => verify::run(&args),
+        Command::Collide(args) => query::collide(&args),
+        Command::Distance(args) => query::distance(&args),
+        Command::Span(args) => query::span(&args),
         Command::Demo(args) => demo::run(&args),
     };
     match outcome {

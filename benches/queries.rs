@@ -1,0 +1,196 @@
+//! Query benchmarks on the dissertation's scenes, with parry3d in the same run.
+//!
+//! - `sliding/<x>`: all contacts between two 40,000-triangle lat/long spheres (radii 1 and
+//!   0.8, §5.3.1), the small one at x with a seeded random rotation; `first/<x>`: first
+//!   contact. Contacts and D, I, S, K are printed once per x.
+//! - `concentric`: exact distance between spheres of radii 1 and 1.05 (gap 0.05).
+//! - `parry/*`: parry3d 0.31 on the same meshes and poses: boolean intersection
+//!   (`query::intersection_test`), all pairs (`Bvh::leaf_pairs` with a posed AABB check,
+//!   then parry's exact triangle test), and distance (`query::distance`).
+//!
+//! Run: `cargo bench --bench queries`.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use obbtree::build::{build, BuildOptions};
+use obbtree::format::ObbtFile;
+use obbtree::mesh::TriMesh;
+use obbtree::query::{
+    collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
+};
+use obbtree::real::Precision;
+use parry3d::bounding_volume::BoundingVolume as _;
+use parry3d::math::{Pose as PPose, Vector as PVector};
+use std::hint::black_box;
+
+const XS: [f64; 5] = [0.2, 0.6, 1.0, 1.4, 1.8];
+
+fn tree(mesh: &TriMesh) -> ObbtFile {
+    build(
+        mesh,
+        &BuildOptions {
+            precision: Precision::F64,
+            ..BuildOptions::default()
+        },
+        None,
+    )
+    .expect("builds")
+}
+
+fn parry_mesh(mesh: &TriMesh) -> parry3d::shape::TriMesh {
+    let v = mesh
+        .vertices()
+        .iter()
+        .map(|p| PVector::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    parry3d::shape::TriMesh::new(v, mesh.faces().to_vec()).expect("parry accepts the mesh")
+}
+
+fn parry_pose(p: &Pose) -> PPose {
+    let r = p.rotation();
+    let m = glam::Mat3::from_cols_array(&[
+        r[(0, 0)] as f32,
+        r[(1, 0)] as f32,
+        r[(2, 0)] as f32,
+        r[(0, 1)] as f32,
+        r[(1, 1)] as f32,
+        r[(2, 1)] as f32,
+        r[(0, 2)] as f32,
+        r[(1, 2)] as f32,
+        r[(2, 2)] as f32,
+    ]);
+    let t = p.translation_vector();
+    PPose::from_parts(
+        PVector::new(t.x as f32, t.y as f32, t.z as f32),
+        glam::Quat::from_mat3(&m),
+    )
+}
+
+/// All intersecting triangle pairs with parry: its BVH pair traversal plus its exact test.
+fn parry_all_pairs(
+    a: &parry3d::shape::TriMesh,
+    b: &parry3d::shape::TriMesh,
+    pos12: &PPose,
+) -> usize {
+    let check = |n1: &parry3d::partitioning::BvhNode, n2: &parry3d::partitioning::BvhNode| {
+        n1.aabb().intersects(&n2.aabb().transform_by(pos12))
+    };
+    let mut count = 0;
+    for (i, j) in a.bvh().leaf_pairs(b.bvh(), check) {
+        let (ta, tb) = (a.triangle(i), b.triangle(j));
+        if parry3d::query::intersection_test(&PPose::IDENTITY, &ta, pos12, &tb)
+            .is_ok_and(|r| r.intersecting)
+        {
+            count += 1;
+        }
+    }
+    count
+}
+
+fn sliding_spheres(c: &mut Criterion) {
+    let big = common::uv_sphere(1.0, 101, 200); // 40,000 triangles
+    let small = common::uv_sphere(0.8, 101, 200);
+    let (ta, tb) = (tree(&big), tree(&small));
+    let (pa, pb) = (parry_mesh(&big), parry_mesh(&small));
+    let mut context = QueryContext::new();
+    let mut group = c.benchmark_group("sliding");
+    println!("\nsliding spheres, 40,000 triangles each, OBB f64:");
+    println!(
+        "{:>5} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12}",
+        "x", "contacts", "D", "I", "S", "K", "parry pairs"
+    );
+    for (step, x) in XS.into_iter().enumerate() {
+        let pose = common::sliding_pose(x, step as u64);
+        let all = CollideOptions::default();
+        let first = CollideOptions {
+            first_contact: true,
+            ..CollideOptions::default()
+        };
+        let r =
+            collide_files(&ta, &Pose::identity(), &tb, &pose, &all, &mut context).expect("query");
+        let pos12 = parry_pose(&pose);
+        let s = r.stats;
+        println!(
+            "{x:>5.1} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12}",
+            r.pairs.len(),
+            s.bv_disjoint,
+            s.bv_overlap,
+            s.tri_separated,
+            s.tri_contact,
+            parry_all_pairs(&pa, &pb, &pos12)
+        );
+        group.bench_with_input(BenchmarkId::new("all", x), &pose, |bench, pose| {
+            bench.iter(|| {
+                collide_files(&ta, &Pose::identity(), &tb, pose, &all, &mut context)
+                    .expect("query")
+                    .pairs
+                    .len()
+            })
+        });
+        group.bench_with_input(BenchmarkId::new("first", x), &pose, |bench, pose| {
+            bench.iter(|| {
+                collide_files(&ta, &Pose::identity(), &tb, pose, &first, &mut context)
+                    .expect("query")
+                    .colliding
+            })
+        });
+        group.bench_with_input(BenchmarkId::new("parry-all", x), &pos12, |bench, pos12| {
+            bench.iter(|| parry_all_pairs(&pa, &pb, pos12))
+        });
+        group.bench_with_input(
+            BenchmarkId::new("parry-boolean", x),
+            &pos12,
+            |bench, pos12| {
+                bench.iter(|| {
+                    parry3d::query::intersection_test(&PPose::IDENTITY, &pa, pos12, &pb)
+                        .expect("supported")
+                        .intersecting
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+fn concentric_spheres(c: &mut Criterion) {
+    let inner = common::uv_sphere(1.0, 101, 200);
+    let outer = common::uv_sphere(1.05, 101, 200);
+    let (ta, tb) = (tree(&inner), tree(&outer));
+    let (pa, pb) = (parry_mesh(&inner), parry_mesh(&outer));
+    let pose = Pose::new(common::seeded_rotation(7), nalgebra::Vector3::zeros()).expect("rotation");
+    let mut context = QueryContext::new();
+    let exact = DistanceOptions::default();
+    let r =
+        distance_files(&ta, &Pose::identity(), &tb, &pose, &exact, &mut context).expect("query");
+    let pos12 = parry_pose(&pose);
+    let parry_d = black_box(parry3d::query::distance(&PPose::IDENTITY, &pa, &pos12, &pb));
+    println!("\nconcentric spheres (1 and 1.05), 40,000 triangles each: distance {} ({:?}); parry: {parry_d:?}", r.distance, r.stats);
+    let mut group = c.benchmark_group("concentric");
+    group.sample_size(10);
+    for rel in [0.0, 0.01, 0.1] {
+        let options = DistanceOptions {
+            rel_err: rel,
+            ..DistanceOptions::default()
+        };
+        group.bench_with_input(
+            BenchmarkId::new("distance-rel-err", rel),
+            &options,
+            |bench, options| {
+                bench.iter(|| {
+                    distance_files(&ta, &Pose::identity(), &tb, &pose, options, &mut context)
+                        .expect("query")
+                        .distance
+                })
+            },
+        );
+    }
+    group.bench_function("parry-distance", |bench| {
+        bench.iter(|| parry3d::query::distance(&PPose::IDENTITY, &pa, &pos12, &pb))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, sliding_spheres, concentric_spheres);
+criterion_main!(benches);

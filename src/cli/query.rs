@@ -1,0 +1,410 @@
+//! `obbtree collide | distance | span`: queries between two posed models.
+
+use super::build::{build_with_progress, load_mesh, TreeArgs};
+use super::Failure;
+use clap::{Args, ValueEnum};
+use obbtree::build::BuildOptions;
+use obbtree::format::layout::SIGNATURE;
+use obbtree::format::ObbtFile;
+use obbtree::query::{
+    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
+    DistanceOptions, Pose, QueryContext, Stats,
+};
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The two models and their poses, shared by every query command.
+#[derive(Args, Debug)]
+pub struct QueryInputs {
+    /// Model A: a .obbt file, or a mesh (.obj, .stl) built in memory first.
+    pub a: PathBuf,
+    /// Model B: a .obbt file, or a mesh built in memory first.
+    pub b: PathBuf,
+    /// Pose of A: 12 comma-separated numbers, the rotation row-major then the translation
+    /// (default: identity).
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
+    pub pose_a: Option<String>,
+    /// Pose of B, as --pose-a.
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
+    pub pose_b: Option<String>,
+    /// A batch of poses: each non-empty line holds 24 numbers (pose A then pose B)
+    /// separated by spaces or commas. Prints one JSON object per line, in input order, each
+    /// with "pose": its line index from 0; queries run in parallel.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["pose_a", "pose_b"])]
+    pub poses: Option<PathBuf>,
+    /// Which tree to descend when both can be: larger diameter, volume or area, or always
+    /// A or B.
+    #[arg(long, value_enum, default_value_t = RuleArg::Diameter)]
+    pub rule: RuleArg,
+    /// Print JSON (one object; a batch always prints JSON lines).
+    #[arg(long)]
+    pub json: bool,
+    /// How mesh inputs are built (ignored for .obbt inputs; a mesh paired with a .obbt file
+    /// is built with that file's volume and precision).
+    #[command(flatten)]
+    pub tree: TreeArgs,
+}
+
+/// `--rule` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum RuleArg {
+    /// Descend the node with the larger diameter.
+    Diameter,
+    /// Descend the node with the larger volume.
+    Volume,
+    /// Descend the node with the larger surface area.
+    Area,
+    /// Always descend A first.
+    A,
+    /// Always descend B first.
+    B,
+}
+
+impl RuleArg {
+    fn rule(self) -> DescentRule {
+        match self {
+            RuleArg::Diameter => DescentRule::LargestDiameter,
+            RuleArg::Volume => DescentRule::LargestVolume,
+            RuleArg::Area => DescentRule::LargestArea,
+            RuleArg::A => DescentRule::AlwaysA,
+            RuleArg::B => DescentRule::AlwaysB,
+        }
+    }
+}
+
+/// Find the triangle pairs where two posed models touch.
+///
+/// Models are surfaces: they collide when some triangle of A shares a point with some
+/// triangle of B (touching counts); a model wholly inside another does not collide.
+///
+/// Example: obbtree collide a.obbt b.obbt --pose-b 1,0,0,0,1,0,0,0,1,0.5,0,0 --pairs
+#[derive(Args, Debug)]
+pub struct CollideArgs {
+    #[command(flatten)]
+    pub inputs: QueryInputs,
+    /// Stop at the first contact found (yes/no with one witness pair).
+    #[arg(long)]
+    pub first: bool,
+    /// List the contacting pairs (input-mesh triangle ids).
+    #[arg(long)]
+    pub pairs: bool,
+}
+
+/// Compute the separation distance between two posed models, with the closest points.
+///
+/// Exact by default. With --rel-err / --abs-err the answer d satisfies
+/// d* <= d <= max(d* (1 + rel), d* + abs) for the true distance d*. With --tolerance T it
+/// only answers whether the models come closer than T, stopping as soon as it knows.
+///
+/// Example: obbtree distance a.obbt b.obbt --pose-b 1,0,0,0,1,0,0,0,1,2,0,0 --json
+#[derive(Args, Debug)]
+pub struct DistanceArgs {
+    #[command(flatten)]
+    pub inputs: QueryInputs,
+    /// Relative error allowed (>= 0).
+    #[arg(long, default_value_t = 0.0, value_name = "E")]
+    pub rel_err: f64,
+    /// Absolute error allowed, model units (>= 0).
+    #[arg(long, default_value_t = 0.0, value_name = "E")]
+    pub abs_err: f64,
+    /// Only decide whether the distance is below T.
+    #[arg(long, value_name = "T", conflicts_with_all = ["rel_err", "abs_err"])]
+    pub tolerance: Option<f64>,
+}
+
+/// Compute the span: the largest distance between a point of A and a point of B.
+///
+/// Example: obbtree span a.obbt b.obbt --json
+#[derive(Args, Debug)]
+pub struct SpanArgs {
+    #[command(flatten)]
+    pub inputs: QueryInputs,
+}
+
+/// Opens a .obbt file, or loads and builds a mesh, matching `like` when given.
+fn open_input(path: &Path, options: &BuildOptions) -> Result<ObbtFile, Failure> {
+    if is_obbt(path) {
+        return Ok(ObbtFile::open(path)?);
+    }
+    let mesh = load_mesh(path)?;
+    build_with_progress(&mesh, options, &path.display().to_string(), false)
+}
+
+fn is_obbt(path: &Path) -> bool {
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && head == SIGNATURE
+}
+
+fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
+    let mut options = inputs.tree.options();
+    // A mesh paired with a tree file is built to match it, so the pair can be queried.
+    for path in [&inputs.a, &inputs.b] {
+        if is_obbt(path) {
+            let info = ObbtFile::open(path)?.info();
+            options.bv = info.bv;
+            options.precision = info.precision;
+            break;
+        }
+    }
+    Ok((
+        open_input(&inputs.a, &options)?,
+        open_input(&inputs.b, &options)?,
+    ))
+}
+
+/// Parses 12 pose numbers from text separated by commas and/or spaces.
+fn parse_pose(text: &str, what: &str) -> Result<Pose, Failure> {
+    let values = parse_numbers(text, what)?;
+    Pose::from_row_major(&values).map_err(|e| Failure(format!("{what}: {e}")))
+}
+
+fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>, Failure> {
+    text.split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .enumerate()
+        .map(|(i, t)| {
+            t.parse::<f64>()
+                .map_err(|_| Failure(format!("{what}: value {i} ({t:?}) is not a number")))
+        })
+        .collect()
+}
+
+/// The pose pairs to run: one from the flags, or a batch from a file.
+fn poses(inputs: &QueryInputs) -> Result<Option<Vec<(Pose, Pose)>>, Failure> {
+    let Some(path) = &inputs.poses else {
+        return Ok(None);
+    };
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Failure(format!("{}: {e}", path.display())))?;
+    let mut out = Vec::new();
+    for (line_no, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let what = format!("{}:{}", path.display(), line_no + 1);
+        let values = parse_numbers(line, &what)?;
+        if values.len() != 24 {
+            return Err(Failure(format!(
+                "{what}: expected 24 numbers (pose A then pose B), got {}",
+                values.len()
+            )));
+        }
+        let a = Pose::from_row_major(&values[..12])
+            .map_err(|e| Failure(format!("{what}: pose A: {e}")))?;
+        let b = Pose::from_row_major(&values[12..])
+            .map_err(|e| Failure(format!("{what}: pose B: {e}")))?;
+        out.push((a, b));
+    }
+    Ok(Some(out))
+}
+
+fn single_pose(inputs: &QueryInputs) -> Result<(Pose, Pose), Failure> {
+    let a = inputs
+        .pose_a
+        .as_deref()
+        .map(|t| parse_pose(t, "--pose-a"))
+        .transpose()?
+        .unwrap_or_default();
+    let b = inputs
+        .pose_b
+        .as_deref()
+        .map(|t| parse_pose(t, "--pose-b"))
+        .transpose()?
+        .unwrap_or_default();
+    Ok((a, b))
+}
+
+fn stats_json(s: &Stats) -> Value {
+    json!({
+        "bv_disjoint": s.bv_disjoint,
+        "bv_overlap": s.bv_overlap,
+        "tri_separated": s.tri_separated,
+        "tri_contact": s.tri_contact,
+        "nodes_visited": s.nodes_visited,
+    })
+}
+
+fn stats_text(s: &Stats) -> String {
+    format!(
+        "D={} I={} S={} K={} nodes visited {}",
+        s.bv_disjoint, s.bv_overlap, s.tri_separated, s.tri_contact, s.nodes_visited
+    )
+}
+
+fn point(p: &nalgebra::Vector3<f64>) -> Value {
+    json!([p.x, p.y, p.z])
+}
+
+/// One query under one pose pair: its JSON object and its human-readable text.
+type Answer = (Value, String);
+
+/// Runs `query` once, or over the batch in parallel, and prints the answers.
+fn run_query<F>(inputs: &QueryInputs, query: F) -> Result<(), Failure>
+where
+    F: Fn(&Pose, &Pose, &mut QueryContext) -> Result<Answer, Failure> + Sync,
+{
+    match poses(inputs)? {
+        None => {
+            let (a, b) = single_pose(inputs)?;
+            let (value, text) = query(&a, &b, &mut QueryContext::new())?;
+            if inputs.json {
+                println!("{value}");
+            } else {
+                println!("{text}");
+            }
+        }
+        Some(batch) => {
+            let answers: Vec<Result<Value, Failure>> = batch
+                .par_iter()
+                .map_init(QueryContext::new, |context, (a, b)| {
+                    query(a, b, context).map(|(v, _)| v)
+                })
+                .collect();
+            for (index, answer) in answers.into_iter().enumerate() {
+                let mut value = answer?;
+                value["pose"] = json!(index);
+                println!("{value}");
+            }
+        }
+    }
+    Ok(())
+}
+
+pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
+    let (a, b) = open_pair(&args.inputs)?;
+    let options = CollideOptions {
+        first_contact: args.first,
+        rule: args.inputs.rule.rule(),
+        ..CollideOptions::default()
+    };
+    run_query(&args.inputs, |pa, pb, context| {
+        let started = Instant::now();
+        let r = collide_files(&a, pa, &b, pb, &options, context)?;
+        let seconds = started.elapsed().as_secs_f64();
+        let mut value = json!({
+            "colliding": r.colliding,
+            "contacts": r.pairs.len(),
+            "stats": stats_json(&r.stats),
+            "seconds": seconds,
+        });
+        if args.pairs {
+            value["pairs"] = json!(r.pairs.iter().map(|&(x, y)| [x, y]).collect::<Vec<_>>());
+        }
+        let mut text = format!(
+            "colliding: {}, {} contact{}{} ({}) in {:.6} s",
+            if r.colliding { "yes" } else { "no" },
+            r.pairs.len(),
+            if r.pairs.len() == 1 { "" } else { "s" },
+            if args.first {
+                " (stopped at the first)"
+            } else {
+                ""
+            },
+            stats_text(&r.stats),
+            seconds
+        );
+        if args.pairs {
+            for (x, y) in &r.pairs {
+                text.push_str(&format!("\n{x} {y}"));
+            }
+        }
+        Ok((value, text))
+    })
+}
+
+pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
+    let (a, b) = open_pair(&args.inputs)?;
+    let rule = args.inputs.rule.rule();
+    let options = DistanceOptions {
+        rel_err: args.rel_err,
+        abs_err: args.abs_err,
+        rule,
+    };
+    run_query(&args.inputs, |pa, pb, context| {
+        let started = Instant::now();
+        if let Some(t) = args.tolerance {
+            let r = within_tolerance_files(&a, pa, &b, pb, t, rule, context)?;
+            let seconds = started.elapsed().as_secs_f64();
+            let w = r.witness.as_ref();
+            let value = json!({
+                "closer_than_tolerance": r.closer,
+                "tolerance": t,
+                "distance": w.map(|w| w.distance),
+                "point_a": w.map(|w| point(&w.point_a)),
+                "point_b": w.map(|w| point(&w.point_b)),
+                "tri_a": w.map(|w| w.tri_a),
+                "tri_b": w.map(|w| w.tri_b),
+                "stats": stats_json(&r.stats),
+                "seconds": seconds,
+            });
+            let text = match w {
+                Some(w) => format!(
+                    "closer than {t}: yes (triangles {} and {} at {}) ({}) in {seconds:.6} s",
+                    w.tri_a,
+                    w.tri_b,
+                    w.distance,
+                    stats_text(&r.stats)
+                ),
+                None => format!(
+                    "closer than {t}: no ({}) in {seconds:.6} s",
+                    stats_text(&r.stats)
+                ),
+            };
+            return Ok((value, text));
+        }
+        let r = distance_files(&a, pa, &b, pb, &options, context)?;
+        let seconds = started.elapsed().as_secs_f64();
+        let value = json!({
+            "distance": r.distance,
+            "point_a": point(&r.point_a),
+            "point_b": point(&r.point_b),
+            "tri_a": r.tri_a,
+            "tri_b": r.tri_b,
+            "stats": stats_json(&r.stats),
+            "seconds": seconds,
+        });
+        let text = format!(
+            "distance: {} between triangle {} of A at {:?} and triangle {} of B at {:?} ({}) in {seconds:.6} s",
+            r.distance,
+            r.tri_a,
+            r.point_a.as_slice(),
+            r.tri_b,
+            r.point_b.as_slice(),
+            stats_text(&r.stats)
+        );
+        Ok((value, text))
+    })
+}
+
+pub fn span(args: &SpanArgs) -> Result<(), Failure> {
+    let (a, b) = open_pair(&args.inputs)?;
+    let rule = args.inputs.rule.rule();
+    run_query(&args.inputs, |pa, pb, context| {
+        let started = Instant::now();
+        let r = span_files(&a, pa, &b, pb, rule, context)?;
+        let seconds = started.elapsed().as_secs_f64();
+        let value = json!({
+            "span": r.span,
+            "point_a": point(&r.point_a),
+            "point_b": point(&r.point_b),
+            "tri_a": r.tri_a,
+            "tri_b": r.tri_b,
+            "stats": stats_json(&r.stats),
+            "seconds": seconds,
+        });
+        let text = format!(
+            "span: {} between {:?} on A and {:?} on B ({}) in {seconds:.6} s",
+            r.span,
+            r.point_a.as_slice(),
+            r.point_b.as_slice(),
+            stats_text(&r.stats)
+        );
+        Ok((value, text))
+    })
+}
