@@ -226,3 +226,181 @@ fn demo_runs() {
         "{text}"
     );
 }
+
+const SHIFT_X: &str = "1,0,0,0,1,0,0,0,1,0.2,0,0";
+
+#[test]
+fn collide_distance_span_print_the_contract_fields() {
+    let dir = scratch("queries");
+    let out = dir.join("cow.obbt");
+    build(&out, &[]);
+    let f = out.to_str().unwrap();
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = obbtree(args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        serde_json::from_slice(&o.stdout).expect("one JSON object")
+    };
+    let stats_keys = [
+        "bv_disjoint",
+        "bv_overlap",
+        "tri_separated",
+        "tri_contact",
+        "nodes_visited",
+    ];
+    let c = json(&["collide", f, f, "--pose-b", SHIFT_X, "--pairs", "--json"]);
+    assert_eq!(c["colliding"], true);
+    let pairs = c["pairs"].as_array().unwrap();
+    assert_eq!(c["contacts"].as_u64().unwrap() as usize, pairs.len());
+    let ids: Vec<(u64, u64)> = pairs
+        .iter()
+        .map(|p| (p[0].as_u64().unwrap(), p[1].as_u64().unwrap()))
+        .collect();
+    assert!(ids.windows(2).all(|w| w[0] < w[1]), "pairs are sorted");
+    assert!(ids.iter().all(|&(a, b)| a < 5804 && b < 5804));
+    for k in stats_keys {
+        assert!(c["stats"][k].is_u64(), "stats.{k}");
+    }
+    assert!(c["seconds"].is_f64());
+    // A mesh input is built in memory to match the other file, with the same answer.
+    let m = json(&["collide", f, &cow(), "--pose-b", SHIFT_X, "--json"]);
+    assert_eq!(m["contacts"], c["contacts"]);
+    let first = json(&["collide", f, f, "--pose-b", SHIFT_X, "--first", "--json"]);
+    assert_eq!(
+        (first["colliding"].clone(), first["contacts"].clone()),
+        (true.into(), 1.into())
+    );
+
+    let far = "1,0,0,0,1,0,0,0,1,3,0,0";
+    let d = json(&["distance", f, f, "--pose-b", far, "--json"]);
+    let distance = d["distance"].as_f64().unwrap();
+    assert!(distance > 1.0 && distance < 3.0, "{distance}");
+    let (pa, pb) = (&d["point_a"], &d["point_b"]);
+    let gap: f64 = (0..3)
+        .map(|k| (pa[k].as_f64().unwrap() - pb[k].as_f64().unwrap()).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!((gap - distance).abs() < 1e-9);
+    assert!(d["tri_a"].is_u64() && d["tri_b"].is_u64());
+    let approx = json(&[
+        "distance",
+        f,
+        f,
+        "--pose-b",
+        far,
+        "--rel-err",
+        "0.1",
+        "--json",
+    ]);
+    let ad = approx["distance"].as_f64().unwrap();
+    assert!(ad >= distance - 1e-12 && ad <= distance * 1.1 + 1e-12);
+    let near = json(&[
+        "distance",
+        f,
+        f,
+        "--pose-b",
+        far,
+        "--tolerance",
+        &(distance * 1.01).to_string(),
+        "--json",
+    ]);
+    assert_eq!(near["closer_than_tolerance"], true);
+    let not = json(&[
+        "distance",
+        f,
+        f,
+        "--pose-b",
+        far,
+        "--tolerance",
+        &(distance * 0.99).to_string(),
+        "--json",
+    ]);
+    assert_eq!(not["closer_than_tolerance"], false);
+
+    let s = json(&["span", f, f, "--pose-b", far, "--json"]);
+    assert!(s["span"].as_f64().unwrap() > 3.0);
+    for k in ["point_a", "point_b", "stats", "seconds"] {
+        assert!(!s[k].is_null(), "span lacks {k}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn pose_batches_print_one_line_per_pose_in_order() {
+    let dir = scratch("batch");
+    let out = dir.join("cow.obbt");
+    build(&out, &[]);
+    let f = out.to_str().unwrap();
+    let poses = dir.join("poses.txt");
+    let identity = "1 0 0 0 1 0 0 0 1 0 0 0";
+    let mut text = String::new();
+    for k in 0..20 {
+        text.push_str(&format!(
+            "{identity}, 1,0,0,0,1,0,0,0,1,{},0,0\n",
+            f64::from(k) * 0.1
+        ));
+        if k == 3 {
+            text.push('\n');
+        }
+    }
+    std::fs::write(&poses, text).unwrap();
+    let o = obbtree(&["collide", f, f, "--poses", poses.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 20);
+    for (k, line) in lines.iter().enumerate() {
+        assert_eq!(line["pose"], k);
+        // The cow is about one unit long: shifted copies overlap, far ones do not.
+        let single = obbtree(&[
+            "collide",
+            f,
+            f,
+            "--pose-b",
+            &format!("1,0,0,0,1,0,0,0,1,{},0,0", k as f64 * 0.1),
+            "--json",
+        ]);
+        let single: serde_json::Value = serde_json::from_slice(&single.stdout).unwrap();
+        assert_eq!(line["contacts"], single["contacts"], "pose {k}");
+    }
+    std::fs::write(&poses, format!("{identity} {identity}\n1 2 3\n")).unwrap();
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--poses", poses.to_str().unwrap()]),
+        "poses.txt:2",
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn malformed_poses_and_mismatched_trees_are_exit_1() {
+    let dir = scratch("badpose");
+    let out = dir.join("cow.obbt");
+    build(&out, &[]);
+    let f = out.to_str().unwrap();
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--pose-b", "1,0,0,0,1,0,0,0,1,x,0,0"]),
+        "--pose-b",
+    );
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--pose-a", "1,0,0"]),
+        "12 numbers",
+    );
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--pose-b", "2,0,0,0,1,0,0,0,1,0,0,0"]),
+        "orthonormal",
+    );
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--pose-b", "-1,0,0,0,1,0,0,0,1,0,0,0"]),
+        "reflection",
+    );
+    assert_bad_input(
+        &obbtree(&["distance", f, f, "--pose-b", "1,0,0,0,1,0,0,0,1,NaN,0,0"]),
+        "not finite",
+    );
+    assert_bad_input(&obbtree(&["distance", f, f, "--rel-err", "-1"]), "rel_err");
+    let aabb = dir.join("aabb.obbt");
+    build(&aabb, &["--bv", "aabb"]);
+    assert_bad_input(&obbtree(&["span", f, aabb.to_str().unwrap()]), "differ");
+    std::fs::remove_dir_all(dir).unwrap();
+}

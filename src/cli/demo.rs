@@ -3,10 +3,15 @@
 use super::build::build_with_progress;
 use super::{human_bytes, Failure};
 use clap::Args;
+use nalgebra::{Rotation3, Vector3};
 use obbtree::build::BuildOptions;
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
+use obbtree::query::{
+    collide_files, distance_files, span_files, CollideOptions, DescentRule, DistanceOptions, Pose,
+    QueryContext,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -16,7 +21,8 @@ const COW_OBJ: &[u8] = include_bytes!("../../assets/cow.obj");
 /// Run the whole pipeline on the bundled cow mesh (5,804 triangles).
 ///
 /// Builds a tree with each bounding volume, writes the files into a directory, opens them
-/// memory-mapped, verifies them, and prints what it built.
+/// memory-mapped, verifies them, prints what it built, then runs collision, distance and
+/// span queries between two posed copies.
 #[derive(Args, Debug)]
 pub struct DemoArgs {
     /// Keep the built files in this directory (default: a temporary one, removed at the end).
@@ -89,6 +95,52 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
             )));
         }
     }
+    run_queries(&dir.join("cow-obb.obbt"))?;
     println!("inspect a file with: obbtree info <file>   (run with --out DIR to keep the files)");
+    Ok(())
+}
+
+/// The three queries between two copies of the cow, the second turned and slid along x.
+fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
+    let cow = ObbtFile::open(path)?;
+    let extent = cow.info().bounds_max[0] - cow.info().bounds_min[0];
+    let mut context = QueryContext::new();
+    let a = Pose::identity();
+    println!("queries between two cows (A fixed, B turned 30 degrees about z and moved along x; lengths in model units):");
+    for shift in [0.25, 0.6, 1.5] {
+        let rotation = *Rotation3::from_euler_angles(0.0, 0.0, 30f64.to_radians()).matrix();
+        let b = Pose::new(rotation, Vector3::new(shift * extent, 0.0, 0.0))?;
+        let started = Instant::now();
+        let all = collide_files(&cow, &a, &cow, &b, &CollideOptions::default(), &mut context)?;
+        let collide_us = started.elapsed().as_secs_f64() * 1e6;
+        let started = Instant::now();
+        let first = CollideOptions {
+            first_contact: true,
+            ..CollideOptions::default()
+        };
+        let any = collide_files(&cow, &a, &cow, &b, &first, &mut context)?;
+        let first_us = started.elapsed().as_secs_f64() * 1e6;
+        let started = Instant::now();
+        let gap = distance_files(
+            &cow,
+            &a,
+            &cow,
+            &b,
+            &DistanceOptions::default(),
+            &mut context,
+        )?;
+        let distance_us = started.elapsed().as_secs_f64() * 1e6;
+        let started = Instant::now();
+        let far = span_files(&cow, &a, &cow, &b, DescentRule::default(), &mut context)?;
+        let span_us = started.elapsed().as_secs_f64() * 1e6;
+        println!(
+            "  B at x = {:.3}: {} contacts ({collide_us:.0} us; first contact {} in {first_us:.0} us), distance {:.4} ({distance_us:.0} us), span {:.4} ({span_us:.0} us)",
+            shift * extent,
+            all.pairs.len(),
+            if any.colliding { "found" } else { "none" },
+            gap.distance,
+            far.span,
+        );
+    }
     Ok(())
 }

@@ -105,13 +105,23 @@ pub struct DistanceArgs {
     #[command(flatten)]
     pub inputs: QueryInputs,
     /// Relative error allowed (>= 0).
-    #[arg(long, default_value_t = 0.0, value_name = "E")]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "E",
+        allow_negative_numbers = true
+    )]
     pub rel_err: f64,
     /// Absolute error allowed, model units (>= 0).
-    #[arg(long, default_value_t = 0.0, value_name = "E")]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "E",
+        allow_negative_numbers = true
+    )]
     pub abs_err: f64,
     /// Only decide whether the distance is below T.
-    #[arg(long, value_name = "T", conflicts_with_all = ["rel_err", "abs_err"])]
+    #[arg(long, value_name = "T", allow_negative_numbers = true, conflicts_with_all = ["rel_err", "abs_err"])]
     pub tolerance: Option<f64>,
 }
 
