@@ -104,3 +104,58 @@ fn concentric_spheres_distance_matches_brute_force() {
         assert_eq!(r.stats.identity_value(), 1);
     }
 }
+
+/// How often an f32 file's contacts differ from an f64 brute force over the input mesh in
+/// the world frame, and that every difference is a pair within a few f32 ulps of touching.
+/// Run with `--nocapture` to see the counts (quoted in the README).
+#[test]
+fn f32_contacts_differ_from_f64_brute_force_only_at_touching_pairs() {
+    let big = common::uv_sphere(1.0, 21, 40);
+    let small = common::uv_sphere(0.8, 21, 40);
+    let options = BuildOptions::default(); // f32
+    let (ta, tb) = (
+        build(&big, &options, None).unwrap(),
+        build(&small, &options, None).unwrap(),
+    );
+    let a = triangles(&big, &Pose::identity());
+    let mut context = QueryContext::new();
+    let (mut total, mut differing, mut worst) = (0usize, 0usize, 0.0f64);
+    for step in 0..40u64 {
+        let x = 0.05 * step as f64;
+        let pose = common::sliding_pose(x, 100 + step);
+        let b = triangles(&small, &pose);
+        let mut expected = std::collections::BTreeSet::new();
+        for (i, s) in a.iter().enumerate() {
+            for (j, t) in b.iter().enumerate() {
+                if triangles_intersect(s, t) {
+                    expected.insert((i as u32, j as u32));
+                }
+            }
+        }
+        let found: std::collections::BTreeSet<(u32, u32)> = collide_files(
+            &ta,
+            &Pose::identity(),
+            &tb,
+            &pose,
+            &CollideOptions::default(),
+            &mut context,
+        )
+        .unwrap()
+        .pairs
+        .into_iter()
+        .collect();
+        total += expected.len();
+        for &(i, j) in expected.symmetric_difference(&found) {
+            differing += 1;
+            let d = triangle_distance(&a[i as usize], &b[j as usize]).distance;
+            worst = worst.max(d);
+            // f32 rounding moves a unit-scale vertex by at most 6e-8.
+            assert!(
+                d <= 2e-7,
+                "x = {x}: pair ({i}, {j}) differs but is {d} apart"
+            );
+        }
+    }
+    println!("f32 vs f64 world-frame brute force: {differing} of {total} contacting pairs differ; largest gap among them {worst:e}");
+    assert!(total > 2_000);
+}
