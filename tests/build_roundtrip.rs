@@ -228,3 +228,12 @@ fn smallest_file_matches_the_spec_test_vector() {
     assert_eq!(tree.nodes()[0].packed, 0);
     assert_eq!(&file.bytes()[..8], b"\x89OBT\r\n\x1a\n");
 }
+
+#[test]
+fn files_and_views_can_be_shared_between_threads() {
+    fn shared<T: Send + Sync>() {}
+    shared::<ObbtFile>();
+    shared::<TreeView<'static, Obb<f32>>>();
+    shared::<TreeView<'static, Sphere<f64>>>();
+    shared::<obbtree::query::QueryContext>();
+}
