@@ -14,30 +14,17 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use obbtree::build::{build, BuildOptions};
-use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{
     collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
 };
-use obbtree::real::Precision;
 use parry3d::bounding_volume::BoundingVolume as _;
 use parry3d::math::{Pose as PPose, Vector as PVector};
 use std::hint::black_box;
 
 const XS: [f64; 5] = [0.2, 0.6, 1.0, 1.4, 1.8];
 
-fn tree(mesh: &TriMesh) -> ObbtFile {
-    build(
-        mesh,
-        &BuildOptions {
-            precision: Precision::F64,
-            ..BuildOptions::default()
-        },
-        None,
-    )
-    .expect("builds")
-}
+use common::tree_f64 as tree;
 
 fn parry_mesh(mesh: &TriMesh) -> parry3d::shape::TriMesh {
     let v = mesh

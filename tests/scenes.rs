@@ -5,12 +5,10 @@ mod common;
 
 use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
-use obbtree::format::ObbtFile;
 use obbtree::query::triangle::{triangle_distance, triangles_intersect, Triangle};
 use obbtree::query::{
     collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
 };
-use obbtree::real::Precision;
 
 fn triangles(mesh: &obbtree::mesh::TriMesh, pose: &Pose) -> Vec<Triangle> {
     mesh.faces()
@@ -19,17 +17,7 @@ fn triangles(mesh: &obbtree::mesh::TriMesh, pose: &Pose) -> Vec<Triangle> {
         .collect()
 }
 
-fn tree(mesh: &obbtree::mesh::TriMesh) -> ObbtFile {
-    build(
-        mesh,
-        &BuildOptions {
-            precision: Precision::F64,
-            ..BuildOptions::default()
-        },
-        None,
-    )
-    .unwrap()
-}
+use common::tree_f64 as tree;
 
 #[test]
 fn sliding_spheres_match_brute_force() {

@@ -1,7 +1,6 @@
 //! Axis-aligned bounding box in the model frame.
 
-use super::obb::box_measures;
-use super::pair::{BoxPair, Transform};
+use super::pair::{box_pair_methods, BoxPair, Transform};
 use super::{all_finite, face_vertices, BoundingVolume, BvDefect, BvKind};
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
@@ -89,28 +88,5 @@ impl<R: Real> BoundingVolume for Aabb<R> {
         (0..3).all(|i| p[i] >= lo[i] - tolerance && p[i] <= hi[i] + tolerance)
     }
 
-    #[inline]
-    fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool {
-        !self.pair_with(other, xf).disjoint(guard)
-    }
-
-    #[inline]
-    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
-        self.pair_with(other, xf).distance_lower_bound()
-    }
-
-    #[inline]
-    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
-        self.pair_with(other, xf).max_distance()
-    }
-
-    fn diameter(&self) -> f64 {
-        box_measures(self.half_f64()).0
-    }
-    fn volume(&self) -> f64 {
-        box_measures(self.half_f64()).1
-    }
-    fn surface_area(&self) -> f64 {
-        box_measures(self.half_f64()).2
-    }
+    box_pair_methods!();
 }

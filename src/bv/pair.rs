@@ -175,3 +175,37 @@ impl BoxPair {
         best.sqrt()
     }
 }
+
+/// The pair tests and size measures shared by the two box volumes, written once: both types
+/// provide `pair_with(&self, &Self, &Transform) -> BoxPair` and `half_f64(&self) -> [f64; 3]`.
+macro_rules! box_pair_methods {
+    () => {
+        #[inline]
+        fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool {
+            !self.pair_with(other, xf).disjoint(guard)
+        }
+
+        #[inline]
+        fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
+            self.pair_with(other, xf).distance_lower_bound()
+        }
+
+        #[inline]
+        fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
+            self.pair_with(other, xf).max_distance()
+        }
+
+        fn diameter(&self) -> f64 {
+            $crate::bv::obb::box_measures(self.half_f64()).0
+        }
+
+        fn volume(&self) -> f64 {
+            $crate::bv::obb::box_measures(self.half_f64()).1
+        }
+
+        fn surface_area(&self) -> f64 {
+            $crate::bv::obb::box_measures(self.half_f64()).2
+        }
+    };
+}
+pub(crate) use box_pair_methods;

@@ -251,6 +251,28 @@ fn point(p: &nalgebra::Vector3<f64>) -> Value {
     json!([p.x, p.y, p.z])
 }
 
+/// The JSON of a distance or span answer: the value under `key`, its witness points (world
+/// frame) and triangles, statistics and query time.
+fn witness_json(
+    key: &str,
+    value: f64,
+    points: [&nalgebra::Vector3<f64>; 2],
+    triangles: [u32; 2],
+    stats: &Stats,
+    seconds: f64,
+) -> Value {
+    let mut out = json!({
+        "point_a": point(points[0]),
+        "point_b": point(points[1]),
+        "tri_a": triangles[0],
+        "tri_b": triangles[1],
+        "stats": stats_json(stats),
+        "seconds": seconds,
+    });
+    out[key] = json!(value);
+    out
+}
+
 /// One query under one pose pair: its JSON object and its human-readable text.
 type Answer = (Value, String);
 
@@ -370,15 +392,14 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         }
         let r = distance_files(&a, pa, &b, pb, &options, context)?;
         let seconds = started.elapsed().as_secs_f64();
-        let value = json!({
-            "distance": r.distance,
-            "point_a": point(&r.point_a),
-            "point_b": point(&r.point_b),
-            "tri_a": r.tri_a,
-            "tri_b": r.tri_b,
-            "stats": stats_json(&r.stats),
-            "seconds": seconds,
-        });
+        let value = witness_json(
+            "distance",
+            r.distance,
+            [&r.point_a, &r.point_b],
+            [r.tri_a, r.tri_b],
+            &r.stats,
+            seconds,
+        );
         let text = format!(
             "distance: {} between triangle {} of A at {:?} and triangle {} of B at {:?} ({}) in {seconds:.6} s",
             r.distance,
@@ -399,15 +420,14 @@ pub fn span(args: &SpanArgs) -> Result<(), Failure> {
         let started = Instant::now();
         let r = span_files(&a, pa, &b, pb, rule, context)?;
         let seconds = started.elapsed().as_secs_f64();
-        let value = json!({
-            "span": r.span,
-            "point_a": point(&r.point_a),
-            "point_b": point(&r.point_b),
-            "tri_a": r.tri_a,
-            "tri_b": r.tri_b,
-            "stats": stats_json(&r.stats),
-            "seconds": seconds,
-        });
+        let value = witness_json(
+            "span",
+            r.span,
+            [&r.point_a, &r.point_b],
+            [r.tri_a, r.tri_b],
+            &r.stats,
+            seconds,
+        );
         let text = format!(
             "span: {} between {:?} on A and {:?} on B ({}) in {seconds:.6} s",
             r.span,

@@ -20,6 +20,15 @@ enum Backing {
     Owned(AlignedBytes),
 }
 
+impl Backing {
+    fn bytes(&self) -> &[u8] {
+        match self {
+            Backing::Mapped(m) => m,
+            Backing::Owned(b) => b.as_bytes(),
+        }
+    }
+}
+
 /// An opened `.obbt` tree: a memory-mapped file or an in-memory image, with its header and
 /// directory checked. Cheap to open whatever the size; `Send + Sync`, so one file can serve
 /// queries on many threads.
@@ -182,10 +191,7 @@ impl ObbtFile {
 
     /// All bytes of the image.
     pub fn bytes(&self) -> &[u8] {
-        match &self.backing {
-            Backing::Mapped(m) => m,
-            Backing::Owned(b) => b.as_bytes(),
-        }
+        self.backing.bytes()
     }
 
     /// The raw header.
@@ -293,10 +299,7 @@ impl ObbtFile {
         if cfg!(target_endian = "big") {
             return Err(FormatError::BigEndianHost);
         }
-        let bytes: &[u8] = match &backing {
-            Backing::Mapped(m) => m,
-            Backing::Owned(b) => b.as_bytes(),
-        };
+        let bytes = backing.bytes();
         if bytes.as_ptr() as usize % SECTION_ALIGN as usize != 0 {
             return Err(FormatError::Misaligned);
         }

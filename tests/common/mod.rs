@@ -210,3 +210,12 @@ pub fn sliding_pose(x: f64, seed: u64) -> obbtree::query::Pose {
     obbtree::query::Pose::new(seeded_rotation(seed), nalgebra::Vector3::new(x, 0.0, 0.0))
         .expect("rotation")
 }
+
+/// The default tree of `mesh` in f64 (the scenes compare against f64 brute force).
+pub fn tree_f64(mesh: &TriMesh) -> obbtree::format::ObbtFile {
+    let options = obbtree::build::BuildOptions {
+        precision: obbtree::real::Precision::F64,
+        ..Default::default()
+    };
+    obbtree::build::build(mesh, &options, None).expect("builds")
+}
