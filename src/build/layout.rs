@@ -3,7 +3,7 @@
 
 use super::topdown::DraftTree;
 use super::{BuildError, BuiltTree};
-use crate::bv::{BoundingVolume, Node};
+use crate::bv::BoundingVolume;
 use crate::mesh::triangle_is_degenerate;
 use crate::tree::{Encoding, NodeRef};
 
@@ -82,11 +82,13 @@ pub(crate) fn finish<B: BoundingVolume>(
     } else {
         Encoding::Variable
     };
-    let nodes = draft
+    // Only the packed references are made here: the writer pairs them with the drafts'
+    // volumes as it encodes the nodes, so the node array is never copied.
+    let packed = draft
         .nodes
         .iter()
-        .map(|d| Ok(Node::new(d.bv, encoding.encode(d.refs)?)))
-        .collect::<Result<Vec<_>, BuildError>>()?;
+        .map(|d| encoding.encode(d.refs))
+        .collect::<Result<Vec<u32>, _>>()?;
     stats.degenerate_triangles = draft
         .faces
         .iter()
@@ -102,7 +104,8 @@ pub(crate) fn finish<B: BoundingVolume>(
         vertices,
         faces: draft.faces,
         source_ids: draft.source_ids,
-        nodes,
+        nodes: draft.nodes,
+        packed,
         encoding,
         stats,
     })

@@ -129,7 +129,10 @@ pub(crate) struct BuiltTree<B: BoundingVolume> {
     pub vertices: Vec<[B::Real; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
-    pub nodes: Vec<crate::bv::Node<B>>,
+    /// The nodes' volumes (with their references before packing).
+    pub nodes: Vec<topdown::Draft<B>>,
+    /// The packed reference of each node, in `encoding`.
+    pub packed: Vec<u32>,
     pub encoding: crate::tree::Encoding,
     pub stats: TreeStats,
 }

@@ -23,6 +23,18 @@ impl AlignedBytes {
         }
     }
 
+    /// `len` zero bytes, written by all threads: a fresh large buffer costs a page fault
+    /// per page on first touch, and this spreads those over the cores.
+    pub(crate) fn zeroed_in_parallel(len: usize) -> AlignedBytes {
+        use rayon::prelude::*;
+        let mut blocks = Vec::new();
+        (0..len.div_ceil(64))
+            .into_par_iter()
+            .map(|_| Block([0; 64]))
+            .collect_into_vec(&mut blocks);
+        AlignedBytes { blocks, len }
+    }
+
     /// An aligned copy of `bytes` (for trees embedded with `include_bytes!` or read by hand).
     pub fn copy_from(bytes: &[u8]) -> AlignedBytes {
         let mut out = AlignedBytes::zeroed(bytes.len());

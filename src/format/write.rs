@@ -7,75 +7,82 @@ use super::layout::{
 };
 use super::open::ObbtFile;
 use crate::build::{BuildOptions, BuiltTree};
-use crate::bv::BoundingVolume;
-use crate::real::Real;
+use crate::bv::{BoundingVolume, Node};
+use crate::real::{Precision, Real};
+use rayon::prelude::*;
 use std::io::Write;
+use std::ops::Range;
 use std::path::Path;
 use zerocopy::IntoBytes;
 
 /// Serializes a finished tree. The layout is fully determined by the tree and options, so
 /// equal inputs give byte-identical images.
+///
+/// Every section is encoded straight into its place in the (zero-initialised) image, so the
+/// image is the only large buffer the writer touches.
 pub(crate) fn serialize<B: BoundingVolume>(
     tree: &BuiltTree<B>,
     options: &BuildOptions,
 ) -> ObbtFile {
-    let mut payloads: Vec<(SectionKind, u64, u32, Vec<u8>)> = Vec::with_capacity(4);
-    let mut vertices = Vec::with_capacity(tree.vertices.len() * 3 * std::mem::size_of::<B::Real>());
-    for v in tree.vertices.iter().flatten() {
-        v.write_le(&mut vertices);
-    }
-    payloads.push((
-        SectionKind::Vertices,
-        tree.vertices.len() as u64,
-        3 * std::mem::size_of::<B::Real>() as u32,
-        vertices,
-    ));
-    let faces: Vec<u8> = tree
-        .faces
-        .iter()
-        .flatten()
-        .flat_map(|i| i.to_le_bytes())
-        .collect();
-    payloads.push((SectionKind::Faces, tree.faces.len() as u64, 12, faces));
-    let ids: Vec<u8> = tree
-        .source_ids
-        .iter()
-        .flat_map(|i| i.to_le_bytes())
-        .collect();
-    payloads.push((SectionKind::SourceIds, tree.source_ids.len() as u64, 4, ids));
-    let mut nodes = Vec::with_capacity(tree.nodes.len() * crate::bv::Node::<B>::SIZE);
-    for n in &tree.nodes {
-        n.write_le(&mut nodes);
-    }
-    payloads.push((
-        SectionKind::Nodes,
-        tree.nodes.len() as u64,
-        crate::bv::Node::<B>::SIZE as u32,
-        nodes,
-    ));
+    let scalar = std::mem::size_of::<B::Real>();
+    // (kind, count, stride) in file order; the byte length of each is count * stride.
+    let sections = [
+        (
+            SectionKind::Vertices,
+            tree.vertices.len() as u64,
+            3 * scalar as u32,
+        ),
+        (SectionKind::Faces, tree.faces.len() as u64, 12),
+        (SectionKind::SourceIds, tree.source_ids.len() as u64, 4),
+        (
+            SectionKind::Nodes,
+            tree.nodes.len() as u64,
+            Node::<B>::SIZE as u32,
+        ),
+    ];
 
-    let header_bytes = HEADER_SIZE + ENTRY_SIZE * payloads.len();
+    let header_bytes = HEADER_SIZE + ENTRY_SIZE * sections.len();
     let mut offset = align64(header_bytes as u64);
-    let mut entries = Vec::with_capacity(payloads.len());
-    for (kind, count, stride, data) in &payloads {
-        entries.push(SectionEntry {
-            kind: kind.tag().into(),
-            flags: FLAG_REQUIRED.into(),
-            offset: offset.into(),
-            length: (data.len() as u64).into(),
-            count: (*count).into(),
-            stride: (*stride).into(),
-            crc32: crc32fast::hash(data).into(),
-        });
-        offset = align64(offset + data.len() as u64);
+    let mut ranges = Vec::with_capacity(sections.len());
+    for &(_, count, stride) in &sections {
+        let length = count * u64::from(stride);
+        ranges.push(offset as usize..(offset + length) as usize);
+        offset = align64(offset + length);
     }
     let total = offset;
-    let mut image = AlignedBytes::zeroed(total as usize);
+    let mut image = AlignedBytes::zeroed_in_parallel(total as usize);
     let bytes = image.as_mut_bytes();
-    for (entry, (_, _, _, data)) in entries.iter().zip(&payloads) {
-        let start = entry.offset.get() as usize;
-        bytes[start..start + data.len()].copy_from_slice(data);
+
+    let [vertices, faces, ids, nodes] = sections_mut(bytes, &ranges);
+    let chunks = vertices.chunks_exact_mut(scalar);
+    for (out, v) in chunks.zip(tree.vertices.iter().flatten()) {
+        put_real(*v, out);
     }
+    for (out, i) in faces.chunks_exact_mut(4).zip(tree.faces.iter().flatten()) {
+        out.copy_from_slice(&i.to_le_bytes());
+    }
+    for (out, i) in ids.chunks_exact_mut(4).zip(&tree.source_ids) {
+        out.copy_from_slice(&i.to_le_bytes());
+    }
+    let nodes_crc = write_nodes(tree, nodes);
+
+    let entries: Vec<SectionEntry> = sections
+        .iter()
+        .zip(&ranges)
+        .map(|(&(kind, count, stride), range)| SectionEntry {
+            kind: kind.tag().into(),
+            flags: FLAG_REQUIRED.into(),
+            offset: (range.start as u64).into(),
+            length: (range.len() as u64).into(),
+            count: count.into(),
+            stride: stride.into(),
+            crc32: match kind {
+                SectionKind::Nodes => nodes_crc,
+                _ => crc32fast::hash(&bytes[range.clone()]),
+            }
+            .into(),
+        })
+        .collect();
     let s = &tree.stats;
     let mut header = Header {
         signature: SIGNATURE,
@@ -88,7 +95,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         encoding: tree.encoding.tag(),
         fit_method: options.fit.tag(),
         leaf_size: (options.leaf_size as u16).into(),
-        section_count: (payloads.len() as u16).into(),
+        section_count: (sections.len() as u16).into(),
         triangles: (tree.faces.len() as u32).into(),
         vertices: (tree.vertices.len() as u32).into(),
         nodes: (tree.nodes.len() as u32).into(),
@@ -110,6 +117,62 @@ pub(crate) fn serialize<B: BoundingVolume>(
     bytes[..HEADER_SIZE].copy_from_slice(header.as_bytes());
     bytes[HEADER_SIZE..header_bytes].copy_from_slice(&directory);
     ObbtFile::from_aligned(image).expect("the writer lays out a valid header and directory")
+}
+
+/// Encodes the nodes of `tree` into `out` (exactly their size) and returns its CRC-32.
+///
+/// The nodes are most of the file: they are encoded in parallel, each fixed-size chunk's
+/// CRC taken while its bytes are still in cache and the CRCs combined in order, so the
+/// result does not depend on the number of threads.
+fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> u32 {
+    const CHUNK: usize = 2048;
+    let size = Node::<B>::SIZE;
+    let hashers: Vec<crc32fast::Hasher> = out
+        .par_chunks_mut(CHUNK * size)
+        .zip(tree.nodes.par_chunks(CHUNK))
+        .zip(tree.packed.par_chunks(CHUNK))
+        .map(|((out, drafts), packed)| {
+            let mut record = Vec::with_capacity(size);
+            for ((out, d), &p) in out.chunks_exact_mut(size).zip(drafts).zip(packed) {
+                record.clear();
+                Node::new(d.bv, p).write_le(&mut record);
+                out.copy_from_slice(&record);
+            }
+            let mut h = crc32fast::Hasher::new();
+            h.update(out);
+            h
+        })
+        .collect();
+    let mut crc = crc32fast::Hasher::new();
+    for h in &hashers {
+        crc.combine(h);
+    }
+    crc.finalize()
+}
+
+/// The four section slices of `bytes` at the (ascending, disjoint) `ranges`.
+fn sections_mut<'a>(bytes: &'a mut [u8], ranges: &[Range<usize>]) -> [&'a mut [u8]; 4] {
+    let mut rest = bytes;
+    let mut consumed = 0;
+    let mut out: [&mut [u8]; 4] = Default::default();
+    for (slot, range) in out.iter_mut().zip(ranges) {
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(range.start - consumed);
+        let (section, tail) = tail.split_at_mut(range.len());
+        *slot = section;
+        rest = tail;
+        consumed = range.end;
+    }
+    out
+}
+
+/// Writes the little-endian encoding of `x` into `out` (exactly its size).
+#[inline]
+fn put_real<R: Real>(x: R, out: &mut [u8]) {
+    match R::PRECISION {
+        // Widening to f64 is exact, so narrowing back gives `x` itself.
+        Precision::F32 => out.copy_from_slice(&(x.to_f64() as f32).to_le_bytes()),
+        Precision::F64 => out.copy_from_slice(&x.to_f64().to_le_bytes()),
+    }
 }
 
 fn align64(n: u64) -> u64 {
