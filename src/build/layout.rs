@@ -74,9 +74,9 @@ pub(crate) fn finish<B: BoundingVolume>(
     vertices: Vec<[B::Real; 3]>,
     positions: &[[f64; 3]],
 ) -> Result<BuiltTree<B>, BuildError> {
-    let (mut stats, binary) =
-        TreeStats::of_nodes(draft.nodes.iter().map(|d| d.refs), draft.nodes.len())
-            .expect("the builder lays children out after their parent");
+    let node_count = draft.node_count();
+    let (mut stats, binary) = TreeStats::of_nodes(draft.drafts().map(|d| d.refs), node_count)
+        .expect("the builder lays children out after their parent");
     let encoding = if binary {
         Encoding::Binary
     } else {
@@ -85,8 +85,7 @@ pub(crate) fn finish<B: BoundingVolume>(
     // Only the packed references are made here: the writer pairs them with the drafts'
     // volumes as it encodes the nodes, so the node array is never copied.
     let packed = draft
-        .nodes
-        .iter()
+        .drafts()
         .map(|d| encoding.encode(d.refs))
         .collect::<Result<Vec<u32>, _>>()?;
     stats.degenerate_triangles = draft
@@ -104,7 +103,7 @@ pub(crate) fn finish<B: BoundingVolume>(
         vertices,
         faces: draft.faces,
         source_ids: draft.source_ids,
-        nodes: draft.nodes,
+        nodes: draft.pieces,
         packed,
         encoding,
         stats,

@@ -129,8 +129,8 @@ pub(crate) struct BuiltTree<B: BoundingVolume> {
     pub vertices: Vec<[B::Real; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
-    /// The nodes' volumes (with their references before packing).
-    pub nodes: Vec<topdown::Draft<B>>,
+    /// The nodes' volumes (with their references before packing), in pieces.
+    pub nodes: Vec<topdown::Piece<B>>,
     /// The packed reference of each node, in `encoding`.
     pub packed: Vec<u32>,
     pub encoding: crate::tree::Encoding,

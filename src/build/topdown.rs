@@ -1,9 +1,9 @@
 //! Top-down construction: fit, enclose, split by centroid, repeat.
 //!
 //! Subtrees are built iteratively with an explicit stack (a mean split can be arbitrarily
-//! unbalanced, so recursion depth is not bounded by log n). Only the top few levels run in
-//! parallel, and their results are merged in a fixed order, so the output never depends on
-//! scheduling.
+//! unbalanced, so recursion depth is not bounded by log n). Nodes large enough to be worth
+//! a task are split in parallel, and the subtrees are then laid out in the order a serial
+//! build gives, so the output never depends on scheduling.
 
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
@@ -18,19 +18,154 @@ pub(crate) struct Draft<B> {
     pub refs: NodeRef,
 }
 
+impl<B> Draft<B> {
+    /// The draft with its child indices moved `by` nodes on.
+    pub fn shifted(self, by: u32) -> Draft<B> {
+        match self.refs {
+            NodeRef::Internal { first, count } => Draft {
+                bv: self.bv,
+                refs: NodeRef::Internal {
+                    first: first + by,
+                    count,
+                },
+            },
+            NodeRef::Leaf { .. } => self,
+        }
+    }
+}
+
 /// The drafts of a whole tree (node 0 the root, children of a node adjacent and after it),
 /// and the faces and their input ids permuted into leaf order.
 pub(crate) struct DraftTree<B> {
-    pub nodes: Vec<Draft<B>>,
+    /// The node array in consecutive pieces (see [`DraftTree::drafts`]).
+    pub pieces: Vec<Piece<B>>,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
 }
 
-/// Levels split in parallel before each subtree is built by one thread: 2^3 = 8 tasks keep
-/// two cores busy without paying for many merges.
-const PARALLEL_LEVELS: u32 = 3;
-/// Below this many triangles a subtree is built by one thread: splitting cost would dominate.
-const PARALLEL_MIN_FACES: usize = 4096;
+impl<B: Copy> DraftTree<B> {
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.pieces.iter().map(Piece::len).sum()
+    }
+
+    /// Every node in order, with final child indices.
+    pub fn drafts(&self) -> impl Iterator<Item = Draft<B>> + '_ {
+        self.pieces.iter().flat_map(Piece::drafts)
+    }
+}
+
+/// A run of consecutive nodes of the final array: `drafts[skip..]`, whose child indices
+/// become final once `shift` is added. Subtrees built by different tasks are placed in
+/// the array this way, without being copied.
+#[derive(Debug)]
+pub(crate) struct Piece<B> {
+    drafts: Vec<Draft<B>>,
+    skip: usize,
+    shift: u32,
+}
+
+impl<B: Copy> Piece<B> {
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.drafts.len().saturating_sub(self.skip)
+    }
+
+    /// The nodes as built, and what to add to their child indices.
+    pub fn raw(&self) -> (&[Draft<B>], u32) {
+        (self.drafts.get(self.skip..).unwrap_or_default(), self.shift)
+    }
+
+    /// The nodes, with final child indices.
+    pub fn drafts(&self) -> impl ExactSizeIterator<Item = Draft<B>> + '_ {
+        let (drafts, shift) = self.raw();
+        drafts.iter().map(move |d| d.shifted(shift))
+    }
+}
+
+/// Nodes with at least this many triangles have their halves built as separate tasks;
+/// smaller subtrees are built by one thread. Small enough to leave a few dozen tasks on a
+/// mesh like the bunny, so the cores run out of work together, and large enough that a
+/// task's work dwarfs its overhead.
+const PARALLEL_MIN_FACES: usize = 1024;
+/// Deepest level split into tasks: bounds the recursion of `build_parallel`, which very
+/// unbalanced splits could otherwise drive as deep as the tree.
+const PARALLEL_MAX_DEPTH: u32 = 20;
+
+/// A subtree as built: one task's drafts in local layout (root at 0), or a node split
+/// into two tasks with the subtrees of its halves.
+enum Subtree<B> {
+    Serial(Vec<Draft<B>>),
+    Split {
+        bv: B,
+        len: usize,
+        left: Box<Subtree<B>>,
+        right: Box<Subtree<B>>,
+    },
+}
+
+impl<B: Copy> Subtree<B> {
+    fn len(&self) -> usize {
+        match self {
+            Subtree::Serial(drafts) => drafts.len(),
+            Subtree::Split { len, .. } => *len,
+        }
+    }
+
+    /// Lays the subtree out as pieces. The layout is the one `build_serial` makes: a node
+    /// is followed by its two children, then by the rest of the left subtree, then by the
+    /// rest of the right one.
+    fn place(self, pieces: &mut Vec<Piece<B>>) {
+        self.place_root(0, pieces);
+        self.place_rest(0, pieces);
+    }
+
+    /// Appends the root, for a subtree whose non-root nodes go at `base + local index`.
+    fn place_root(&self, base: u32, pieces: &mut Vec<Piece<B>>) {
+        let root = match self {
+            Subtree::Serial(drafts) => match drafts.first() {
+                Some(d) => d.shifted(base),
+                None => return,
+            },
+            Subtree::Split { bv, .. } => Draft {
+                bv: *bv,
+                refs: NodeRef::Internal {
+                    first: base + 1,
+                    count: 2,
+                },
+            },
+        };
+        pieces.push(Piece {
+            drafts: vec![root],
+            skip: 0,
+            shift: 0,
+        });
+    }
+
+    /// Appends every node but the root (see [`Subtree::place_root`]).
+    fn place_rest(self, base: u32, pieces: &mut Vec<Piece<B>>) {
+        match self {
+            Subtree::Serial(drafts) => {
+                if drafts.len() > 1 {
+                    pieces.push(Piece {
+                        drafts,
+                        skip: 1,
+                        shift: base,
+                    });
+                }
+            }
+            Subtree::Split { left, right, .. } => {
+                // Local layout: [root, left root, right root, left rest, right rest].
+                let left_base = base + 2;
+                let right_base = base + 1 + left.len() as u32;
+                left.place_root(left_base, pieces);
+                right.place_root(right_base, pieces);
+                left.place_rest(left_base, pieces);
+                right.place_rest(right_base, pieces);
+            }
+        }
+    }
+}
 
 struct Context<'a> {
     positions: &'a [[f64; 3]],
@@ -51,9 +186,11 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
         options,
         progress,
     };
-    let nodes = build_parallel(&ctx, &mut faces, &mut source_ids, 0, PARALLEL_LEVELS);
+    let tree = build_parallel::<B>(&ctx, &mut faces, &mut source_ids, 0, 0);
+    let mut pieces = Vec::new();
+    tree.place(&mut pieces);
     DraftTree {
-        nodes,
+        pieces,
         faces,
         source_ids,
     }
@@ -137,62 +274,34 @@ fn build_parallel<B: BoundingVolume>(
     faces: &mut [[u32; 3]],
     ids: &mut [u32],
     face_offset: u32,
-    levels: u32,
-) -> Vec<Draft<B>> {
-    if levels == 0 || faces.len() < PARALLEL_MIN_FACES {
-        return build_serial(ctx, faces, ids, face_offset);
+    depth: u32,
+) -> Subtree<B> {
+    if depth >= PARALLEL_MAX_DEPTH || faces.len() < PARALLEL_MIN_FACES {
+        return Subtree::Serial(build_serial(ctx, faces, ids, face_offset));
     }
     let mut scratch = Vec::new();
     let (bv, split) = fit_and_split::<B>(ctx, faces, ids, &mut scratch);
     let Some(mid) = split else {
-        return vec![Draft {
+        return Subtree::Serial(vec![Draft {
             bv,
             refs: NodeRef::Leaf {
                 first: face_offset,
                 count: faces.len() as u32,
             },
-        }];
+        }]);
     };
     let (fl, fr) = faces.split_at_mut(mid);
     let (il, ir) = ids.split_at_mut(mid);
     let (left, right) = rayon::join(
-        || build_parallel::<B>(ctx, fl, il, face_offset, levels - 1),
-        || build_parallel::<B>(ctx, fr, ir, face_offset + mid as u32, levels - 1),
+        || build_parallel::<B>(ctx, fl, il, face_offset, depth + 1),
+        || build_parallel::<B>(ctx, fr, ir, face_offset + mid as u32, depth + 1),
     );
-    merge(bv, left, right)
-}
-
-/// One parent over two subtrees in local layout `[root, children..., rest]`: the result is
-/// `[parent, left root, right root, left rest, right rest]`, re-indexed.
-fn merge<B: BoundingVolume>(bv: B, left: Vec<Draft<B>>, right: Vec<Draft<B>>) -> Vec<Draft<B>> {
-    let shift = |d: Draft<B>, by: u32| match d.refs {
-        NodeRef::Internal { first, count } => Draft {
-            bv: d.bv,
-            refs: NodeRef::Internal {
-                first: first + by,
-                count,
-            },
-        },
-        leaf => Draft {
-            bv: d.bv,
-            refs: leaf,
-        },
-    };
-    let nl = left.len() as u32;
-    // The roots move to 1 and 2, left node j >= 1 to j + 2, right node j >= 1 to j + nl + 1.
-    // A local child index is never 0, so shifting every internal reference is exact.
-    let mut out = Vec::with_capacity(1 + left.len() + right.len());
-    out.push(Draft {
+    Subtree::Split {
         bv,
-        refs: NodeRef::Internal { first: 1, count: 2 },
-    });
-    let mut l = left.into_iter();
-    let mut r = right.into_iter();
-    out.extend(l.next().map(|d| shift(d, 2)));
-    out.extend(r.next().map(|d| shift(d, nl + 1)));
-    out.extend(l.map(|d| shift(d, 2)));
-    out.extend(r.map(|d| shift(d, nl + 1)));
-    out
+        len: 1 + left.len() + right.len(),
+        left: Box::new(left),
+        right: Box::new(right),
+    }
 }
 
 /// Builds one subtree with an explicit stack, depth first, children allocated as adjacent

@@ -36,7 +36,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         (SectionKind::SourceIds, tree.source_ids.len() as u64, 4),
         (
             SectionKind::Nodes,
-            tree.nodes.len() as u64,
+            tree.packed.len() as u64,
             Node::<B>::SIZE as u32,
         ),
     ];
@@ -98,7 +98,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         section_count: (sections.len() as u16).into(),
         triangles: (tree.faces.len() as u32).into(),
         vertices: (tree.vertices.len() as u32).into(),
-        nodes: (tree.nodes.len() as u32).into(),
+        nodes: (tree.packed.len() as u32).into(),
         leaves: s.leaves.into(),
         depth: s.depth.into(),
         degenerate_triangles: s.degenerate_triangles.into(),
@@ -121,17 +121,29 @@ pub(crate) fn serialize<B: BoundingVolume>(
 
 /// Encodes the nodes of `tree` into `out` (exactly their size) and returns its CRC-32.
 ///
-/// The nodes are most of the file: they are encoded in parallel, each fixed-size chunk's
-/// CRC taken while its bytes are still in cache and the CRCs combined in order, so the
-/// result does not depend on the number of threads.
+/// The nodes are most of the file: they are encoded in parallel, in runs of at most
+/// `CHUNK` nodes (cut at the same places whatever the number of threads), each run's CRC
+/// taken while its bytes are still in cache and the CRCs combined in order.
 fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> u32 {
     const CHUNK: usize = 2048;
     let size = Node::<B>::SIZE;
-    let hashers: Vec<crc32fast::Hasher> = out
-        .par_chunks_mut(CHUNK * size)
-        .zip(tree.nodes.par_chunks(CHUNK))
-        .zip(tree.packed.par_chunks(CHUNK))
-        .map(|((out, drafts), packed)| {
+    // (drafts, packed references, output) of each run, in order. The references are
+    // already packed, so the drafts' own (unshifted) ones are not needed.
+    let mut runs = Vec::new();
+    let (mut out, mut packed) = (out, tree.packed.as_slice());
+    for piece in &tree.nodes {
+        for drafts in piece.raw().0.chunks(CHUNK) {
+            let n = drafts.len();
+            let (o, rest) = std::mem::take(&mut out).split_at_mut(n * size);
+            let (p, rest_packed) = packed.split_at(n);
+            runs.push((drafts, p, o));
+            out = rest;
+            packed = rest_packed;
+        }
+    }
+    let hashers: Vec<crc32fast::Hasher> = runs
+        .into_par_iter()
+        .map(|(drafts, packed, out)| {
             let mut record = Vec::with_capacity(size);
             for ((out, d), &p) in out.chunks_exact_mut(size).zip(drafts).zip(packed) {
                 record.clear();
