@@ -7,7 +7,7 @@
 
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
-use crate::fit::principal_axes;
+use crate::fit::principal_axes_and_vertices;
 use crate::tree::NodeRef;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -196,16 +196,26 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
     }
 }
 
+/// Buffers reused from node to node by one task.
+#[derive(Default)]
+struct Scratch {
+    /// The distinct vertices of the node.
+    vertices: Vec<u32>,
+    /// Centroid projections for the split.
+    proj: Vec<f64>,
+}
+
 /// Fits node `faces` and, unless it is a leaf, partitions them (and `ids` alike) into two
 /// non-empty halves, returning the size of the first.
 fn fit_and_split<B: BoundingVolume>(
     ctx: &Context,
     faces: &mut [[u32; 3]],
     ids: &mut [u32],
-    scratch: &mut Vec<f64>,
+    scratch: &mut Scratch,
 ) -> (B, Option<usize>) {
-    let axes = principal_axes(ctx.options.fit, ctx.positions, faces);
-    let bv = B::enclose(&axes, ctx.positions, faces);
+    let axes =
+        principal_axes_and_vertices(ctx.options.fit, ctx.positions, faces, &mut scratch.vertices);
+    let bv = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
     if faces.len() <= ctx.options.leaf_size as usize {
         if let Some(p) = ctx.progress {
             p.fetch_add(faces.len() as u64, Ordering::Relaxed);
@@ -213,7 +223,10 @@ fn fit_and_split<B: BoundingVolume>(
         return (bv, None);
     }
     let axis = [axes[(0, 0)], axes[(1, 0)], axes[(2, 0)]];
-    (bv, Some(split(ctx.positions, axis, faces, ids, scratch)))
+    (
+        bv,
+        Some(split(ctx.positions, axis, faces, ids, &mut scratch.proj)),
+    )
 }
 
 /// Partitions by centroid projection on `axis`: below the mean to the front. If that leaves
@@ -279,7 +292,7 @@ fn build_parallel<B: BoundingVolume>(
     if depth >= PARALLEL_MAX_DEPTH || faces.len() < PARALLEL_MIN_FACES {
         return Subtree::Serial(build_serial(ctx, faces, ids, face_offset));
     }
-    let mut scratch = Vec::new();
+    let mut scratch = Scratch::default();
     let (bv, split) = fit_and_split::<B>(ctx, faces, ids, &mut scratch);
     let Some(mid) = split else {
         return Subtree::Serial(vec![Draft {
@@ -318,7 +331,7 @@ fn build_serial<B: BoundingVolume>(
     };
     let mut nodes = vec![placeholder];
     let mut stack = vec![(0usize, 0usize, faces.len())];
-    let mut scratch = Vec::new();
+    let mut scratch = Scratch::default();
     while let Some((slot, start, end)) = stack.pop() {
         let (bv, split) = fit_and_split::<B>(
             ctx,

@@ -1,7 +1,7 @@
 //! Axis-aligned bounding box in the model frame.
 
 use super::pair::{box_pair_methods, BoxPair, Transform};
-use super::{all_finite, face_vertices, BoundingVolume, BvDefect, BvKind};
+use super::{all_finite, face_vertices, listed_vertices, BoundingVolume, BvDefect, BvKind};
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -41,16 +41,12 @@ impl<R: Real> Aabb<R> {
     fn half_f64(&self) -> [f64; 3] {
         std::array::from_fn(|i| 0.5 * (self.max[i].to_f64() - self.min[i].to_f64()))
     }
-}
 
-impl<R: Real> BoundingVolume for Aabb<R> {
-    type Real = R;
-    const KIND: BvKind = BvKind::Aabb;
-
-    fn enclose(_frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
+    /// The box of `points` (see [`BoundingVolume::enclose`]).
+    fn enclose_points<'a>(points: impl Iterator<Item = &'a [f64; 3]>) -> Self {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for p in face_vertices(positions, faces) {
+        for p in points {
             for i in 0..3 {
                 lo[i] = lo[i].min(p[i]);
                 hi[i] = hi[i].max(p[i]);
@@ -65,6 +61,19 @@ impl<R: Real> BoundingVolume for Aabb<R> {
             min: lo.map(R::from_f64_down),
             max: hi.map(R::from_f64_up),
         }
+    }
+}
+
+impl<R: Real> BoundingVolume for Aabb<R> {
+    type Real = R;
+    const KIND: BvKind = BvKind::Aabb;
+
+    fn enclose(_frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
+        Self::enclose_points(face_vertices(positions, faces))
+    }
+
+    fn enclose_vertices(_frame: &Matrix3<f64>, positions: &[[f64; 3]], vertices: &[u32]) -> Self {
+        Self::enclose_points(listed_vertices(positions, vertices))
     }
 
     fn write_le(&self, out: &mut Vec<u8>) {

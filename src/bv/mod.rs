@@ -104,6 +104,15 @@ pub trait BoundingVolume:
     /// result contains them exactly: every rounding to [`Self::Real`] is outward.
     fn enclose(axes: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self;
 
+    /// The same volume as [`BoundingVolume::enclose`] of any faces whose vertices are
+    /// `vertices` (indices into `positions`; repeats allowed, out-of-range ones ignored):
+    /// the volume depends only on the set of vertices, so a caller that has already found
+    /// the distinct ones need not visit every corner of every face.
+    fn enclose_vertices(axes: &Matrix3<f64>, positions: &[[f64; 3]], vertices: &[u32]) -> Self {
+        let faces: Vec<[u32; 3]> = vertices.iter().map(|&v| [v, v, v]).collect();
+        Self::enclose(axes, positions, &faces)
+    }
+
     /// Appends the little-endian bytes of this volume in on-disk field order.
     fn write_le(&self, out: &mut Vec<u8>);
 
@@ -202,10 +211,20 @@ pub(crate) fn l1(p: &[f64; 3]) -> f64 {
 pub(crate) fn face_vertices<'a>(
     positions: &'a [[f64; 3]],
     faces: &'a [[u32; 3]],
-) -> impl Iterator<Item = &'a [f64; 3]> + 'a {
+) -> impl Iterator<Item = &'a [f64; 3]> + Clone + 'a {
     faces
         .iter()
         .flatten()
+        .filter_map(move |&v| positions.get(v as usize))
+}
+
+/// The positions of `vertices` (out-of-range indices skipped).
+pub(crate) fn listed_vertices<'a>(
+    positions: &'a [[f64; 3]],
+    vertices: &'a [u32],
+) -> impl Iterator<Item = &'a [f64; 3]> + Clone + 'a {
+    vertices
+        .iter()
         .filter_map(move |&v| positions.get(v as usize))
 }
 

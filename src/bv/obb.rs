@@ -1,7 +1,7 @@
 //! Oriented bounding box (dissertation §3.2).
 
 use super::pair::{box_pair_methods, BoxPair, Transform};
-use super::{all_finite, face_vertices, l1, projection_slack, BoundingVolume, BvDefect, BvKind};
+use super::{all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect, BvKind};
 use crate::real::{point_to_f64, Precision, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -67,6 +67,48 @@ impl<R: Real> Obb<R> {
     pub fn half_f64(&self) -> [f64; 3] {
         point_to_f64(&self.half)
     }
+
+    /// The box of `points` along `frame`'s columns (see [`BoundingVolume::enclose`]).
+    fn enclose_points<'a>(
+        frame: &Matrix3<f64>,
+        points: impl Iterator<Item = &'a [f64; 3]>,
+    ) -> Self {
+        // Round the axes first and measure along the rounded ones, so the stored box is
+        // exactly the one whose extents were computed.
+        let axes_r: [[R; 3]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|j| R::from_f64_nearest(frame[(j, i)])));
+        let a = axes_r.map(|row| point_to_f64(&row));
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut l1_max = 0.0f64;
+        for p in points {
+            for i in 0..3 {
+                let d = dot(&a[i], p);
+                lo[i] = lo[i].min(d);
+                hi[i] = hi[i].max(d);
+            }
+            l1_max = l1_max.max(l1(p));
+        }
+        if !lo[0].is_finite() {
+            // No vertices (callers never do this): an empty box at the origin.
+            lo = [0.0; 3];
+            hi = [0.0; 3];
+        }
+        let mid: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
+        let c: [f64; 3] = std::array::from_fn(|j| (0..3).map(|i| a[i][j] * mid[i]).sum());
+        let center = c.map(R::from_f64_nearest);
+        let c = point_to_f64(&center);
+        let slack = 2.0 * projection_slack(l1_max + l1(&c));
+        let half = std::array::from_fn(|i| {
+            let d = dot(&a[i], &c);
+            R::from_f64_up((hi[i] - d).max(d - lo[i]).max(0.0) + slack)
+        });
+        Obb {
+            axes: axes_r,
+            center,
+            half,
+        }
+    }
 }
 
 pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -95,41 +137,11 @@ impl<R: Real> BoundingVolume for Obb<R> {
     const KIND: BvKind = BvKind::Obb;
 
     fn enclose(frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
-        // Round the axes first and measure along the rounded ones, so the stored box is
-        // exactly the one whose extents were computed.
-        let axes_r: [[R; 3]; 3] =
-            std::array::from_fn(|i| std::array::from_fn(|j| R::from_f64_nearest(frame[(j, i)])));
-        let a = axes_r.map(|row| point_to_f64(&row));
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let mut l1_max = 0.0f64;
-        for p in face_vertices(positions, faces) {
-            for i in 0..3 {
-                let d = dot(&a[i], p);
-                lo[i] = lo[i].min(d);
-                hi[i] = hi[i].max(d);
-            }
-            l1_max = l1_max.max(l1(p));
-        }
-        if !lo[0].is_finite() {
-            // No vertices (callers never do this): an empty box at the origin.
-            lo = [0.0; 3];
-            hi = [0.0; 3];
-        }
-        let mid: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
-        let c: [f64; 3] = std::array::from_fn(|j| (0..3).map(|i| a[i][j] * mid[i]).sum());
-        let center = c.map(R::from_f64_nearest);
-        let c = point_to_f64(&center);
-        let slack = 2.0 * projection_slack(l1_max + l1(&c));
-        let half = std::array::from_fn(|i| {
-            let d = dot(&a[i], &c);
-            R::from_f64_up((hi[i] - d).max(d - lo[i]).max(0.0) + slack)
-        });
-        Obb {
-            axes: axes_r,
-            center,
-            half,
-        }
+        Self::enclose_points(frame, face_vertices(positions, faces))
+    }
+
+    fn enclose_vertices(frame: &Matrix3<f64>, positions: &[[f64; 3]], vertices: &[u32]) -> Self {
+        Self::enclose_points(frame, listed_vertices(positions, vertices))
     }
 
     fn write_le(&self, out: &mut Vec<u8>) {

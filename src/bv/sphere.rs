@@ -2,7 +2,10 @@
 
 use super::obb::dot;
 use super::pair::Transform;
-use super::{all_finite, face_vertices, l1, projection_slack, BoundingVolume, BvDefect, BvKind};
+use super::{
+    all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
+    BvKind,
+};
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -28,20 +31,16 @@ impl<R: Real> Sphere<R> {
         let cb = xf.apply(&Vector3::from(point_to_f64(&other.center)));
         (cb - Vector3::from(point_to_f64(&self.center))).norm()
     }
-}
 
-impl<R: Real> BoundingVolume for Sphere<R> {
-    type Real = R;
-    const KIND: BvKind = BvKind::Sphere;
-
-    /// Centred on the middle of the vertices' extents along the fitted axes (the centre of
-    /// the OBB of the same frame), which for elongated sets is far tighter than the
-    /// centroid; the radius is the largest distance from that centre.
-    fn enclose(frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
+    /// The sphere of `points` for `frame` (see [`BoundingVolume::enclose`]).
+    fn enclose_points<'a>(
+        frame: &Matrix3<f64>,
+        points: impl Iterator<Item = &'a [f64; 3]> + Clone,
+    ) -> Self {
         let axes: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| frame[(j, i)]));
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for p in face_vertices(positions, faces) {
+        for p in points.clone() {
             for i in 0..3 {
                 let d = dot(&axes[i], p);
                 lo[i] = lo[i].min(d);
@@ -58,7 +57,7 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         let c = point_to_f64(&center);
         let mut r2 = 0.0f64;
         let mut l1_max = 0.0f64;
-        for p in face_vertices(positions, faces) {
+        for p in points {
             let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
             r2 = r2.max(dot(&d, &d));
             l1_max = l1_max.max(l1(p));
@@ -68,6 +67,22 @@ impl<R: Real> BoundingVolume for Sphere<R> {
             center,
             radius: R::from_f64_up(r2.sqrt() + slack),
         }
+    }
+}
+
+impl<R: Real> BoundingVolume for Sphere<R> {
+    type Real = R;
+    const KIND: BvKind = BvKind::Sphere;
+
+    /// Centred on the middle of the vertices' extents along the fitted axes (the centre of
+    /// the OBB of the same frame), which for elongated sets is far tighter than the
+    /// centroid; the radius is the largest distance from that centre.
+    fn enclose(frame: &Matrix3<f64>, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Self {
+        Self::enclose_points(frame, face_vertices(positions, faces))
+    }
+
+    fn enclose_vertices(frame: &Matrix3<f64>, positions: &[[f64; 3]], vertices: &[u32]) -> Self {
+        Self::enclose_points(frame, listed_vertices(positions, vertices))
     }
 
     fn write_le(&self, out: &mut Vec<u8>) {

@@ -132,14 +132,38 @@ pub fn principal_axes(
     }
 }
 
+/// [`principal_axes`], also setting `vertices` to the distinct vertex indices of `faces`
+/// (in range, each once, in some deterministic order), which the fit finds anyway.
+pub(crate) fn principal_axes_and_vertices(
+    method: FitMethod,
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    vertices: &mut Vec<u32>,
+) -> Matrix3<f64> {
+    vertices.clear();
+    if faces.len() <= 1 {
+        vertices.extend(faces.iter().flatten().copied());
+        return principal_axes(method, positions, faces);
+    }
+    let frame = with_scratch(|s| {
+        let frame = principal::fit(s, method, positions, faces);
+        vertices.extend_from_slice(&s.ids);
+        frame
+    });
+    if frame.iter().all(|v| v.is_finite()) {
+        frame
+    } else {
+        Matrix3::identity()
+    }
+}
+
 /// Runs `f` on this thread's scratch buffers (fresh ones if those are unavailable).
-fn with_scratch(f: impl Fn(&mut scratch::Scratch) -> Matrix3<f64>) -> Matrix3<f64> {
-    SCRATCH
-        .try_with(|cell| match cell.try_borrow_mut() {
-            Ok(mut s) => f(&mut s),
-            // Re-entrant use (impossible today): fresh buffers.
-            Err(_) => f(&mut scratch::Scratch::default()),
-        })
-        // The thread is being torn down: fresh buffers.
-        .unwrap_or_else(|_| f(&mut scratch::Scratch::default()))
+fn with_scratch(mut f: impl FnMut(&mut scratch::Scratch) -> Matrix3<f64>) -> Matrix3<f64> {
+    let shared = SCRATCH.try_with(|cell| cell.try_borrow_mut().ok().map(|mut s| f(&mut s)));
+    match shared {
+        Ok(Some(frame)) => frame,
+        // Re-entrant use (impossible today) or the thread is being torn down: fresh
+        // buffers.
+        _ => f(&mut scratch::Scratch::default()),
+    }
 }

@@ -16,6 +16,9 @@ pub(crate) struct Scratch {
     generation: u32,
     /// The distinct vertices of the current face set, centred at their bounding-box centre.
     pub(crate) pts: Vec<V3>,
+    /// The indices of the distinct vertices, in order of first reference (before welding,
+    /// which may merge and reorder `pts`).
+    pub(crate) ids: Vec<u32>,
     /// Largest absolute coordinate before centring (sets the "single point" floor).
     pub(crate) magnitude: f64,
     /// Convex-hull buffers.
@@ -24,10 +27,12 @@ pub(crate) struct Scratch {
 
 impl Scratch {
     /// Fills [`Scratch::pts`] with the vertices referenced by `faces`, each index once, in
-    /// order of first reference; with `weld`, vertices at bitwise-equal positions are
-    /// merged too (and the order becomes lexicographic). Indices out of range are ignored.
+    /// order of first reference (and [`Scratch::ids`] with their indices); with `weld`,
+    /// vertices at bitwise-equal positions are merged too (and the order becomes
+    /// lexicographic). Indices out of range are ignored.
     pub(crate) fn gather(&mut self, positions: &[[f64; 3]], faces: &[[u32; 3]], weld: bool) {
         self.pts.clear();
+        self.ids.clear();
         if self.stamp.len() < positions.len() {
             self.stamp.resize(positions.len(), 0);
         }
@@ -39,12 +44,13 @@ impl Scratch {
         }
         let generation = self.generation;
         for f in faces {
-            for &i in f {
-                let i = i as usize;
+            for &v in f {
+                let i = v as usize;
                 if let (Some(st), Some(&p)) = (self.stamp.get_mut(i), positions.get(i)) {
                     if *st != generation {
                         *st = generation;
                         self.pts.push(p);
+                        self.ids.push(v);
                     }
                 }
             }
