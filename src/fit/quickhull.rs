@@ -117,6 +117,13 @@ impl QuickHull {
         if n < 4 || n >= NONE as usize || eps.is_nan() || eps < 0.0 {
             return Err(QuickHullError::Input);
         }
+        if n == 4 {
+            // Four affinely independent points: the hull is the seed tetrahedron itself.
+            for (v, _) in seed_faces(points, simplex)? {
+                out.push(v);
+            }
+            return Ok(());
+        }
         self.faces.clear();
         self.free.clear();
         self.pending.clear();
@@ -173,30 +180,13 @@ impl QuickHull {
 
     /// Builds the four faces of the seed tetrahedron, oriented outwards, with adjacency.
     fn seed(&mut self, points: &[V3], s: [usize; 4], eps: f64) -> Result<(), QuickHullError> {
-        let pt = |i: usize| points.get(i).copied().ok_or(QuickHullError::Input);
-        // Each face with the vertex it must face away from.
-        let combos = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)];
-        for (a, b, c, o) in combos {
-            let (ia, mut ib, mut ic, io) = (s[a], s[b], s[c], s[o]);
-            let normal = cross(sub(pt(ib)?, pt(ia)?), sub(pt(ic)?, pt(ia)?));
-            if dot(normal, sub(pt(io)?, pt(ia)?)) > 0.0 {
-                std::mem::swap(&mut ib, &mut ic);
-            }
-            let f = self.new_face(points, [ia as u32, ib as u32, ic as u32], eps)?;
-            if f as usize != self.faces.len() - 1 {
+        for (k, (v, adj)) in seed_faces(points, s)?.into_iter().enumerate() {
+            let f = self.new_face(points, v, eps)?;
+            let face = self.faces.get_mut(f as usize).ok_or(QuickHullError::Input)?;
+            if f as usize != k {
                 return Err(QuickHullError::Input);
             }
-        }
-        // Adjacency by matching each edge with its reverse.
-        for f in 0..4 {
-            for i in 0..3 {
-                let v = self.faces[f].v;
-                let (a, b) = (v[i], v[(i + 1) % 3]);
-                let g = (0..4)
-                    .find(|&g| g != f && find_edge(&self.faces[g].v, b, a).is_some())
-                    .ok_or(QuickHullError::Input)?;
-                self.faces[f].adj[i] = g as u32;
-            }
+            face.adj = adj;
         }
         Ok(())
     }
@@ -606,6 +596,35 @@ fn broken_edge(face: &Face, normal: V3, far: V3, limit: f64, flat: f64) -> bool 
     let reflex = d > 0.0 && d * d > limit * len2;
     let folded = d * d <= flat * len2 && dot(face.normal, normal) < 0.0;
     reflex || folded
+}
+
+/// The faces of the tetrahedron on `s` (indices into `points`), counter-clockwise seen
+/// from outside, each with the faces across its edges (as in [`Face::adj`]). Face `k`
+/// leaves out `s[3 - k]`, so the face across an edge is the one that leaves out the third
+/// vertex of the face on this side. Fails on an index out of range or a face of zero
+/// area.
+#[allow(clippy::type_complexity)]
+fn seed_faces(points: &[V3], s: [usize; 4]) -> Result<[([u32; 3], [u32; 3]); 4], QuickHullError> {
+    let pt = |i: usize| points.get(i).copied().ok_or(QuickHullError::Input);
+    // Each face with the vertex it must face away from, as positions in `s`.
+    let combos = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)];
+    let mut faces = [([0; 3], [0; 3]); 4];
+    for (face, (a, mut b, mut c, o)) in faces.iter_mut().zip(combos) {
+        let (pa, pb, pc, po) = (pt(s[a])?, pt(s[b])?, pt(s[c])?, pt(s[o])?);
+        let normal = cross(sub(pb, pa), sub(pc, pa));
+        if dot(normal, sub(po, pa)) > 0.0 {
+            std::mem::swap(&mut b, &mut c);
+        }
+        let len2 = norm2(normal);
+        if !(len2 > 0.0 && len2.is_finite()) {
+            return Err(QuickHullError::Numerical);
+        }
+        *face = (
+            [s[a] as u32, s[b] as u32, s[c] as u32],
+            [3 - c as u32, 3 - a as u32, 3 - b as u32],
+        );
+    }
+    Ok(faces)
 }
 
 /// Position `j` with `v[j] == a` and `v[(j + 1) % 3] == b`, if the triangle has that edge.
