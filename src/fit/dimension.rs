@@ -51,25 +51,56 @@ impl Shape {
 /// the floor below which the whole set is one point. Never panics; an empty or non-finite
 /// set is reported as a point.
 pub(crate) fn classify(points: &[V3], magnitude: f64) -> Shape {
-    let Some(&first) = points.first() else {
-        return Shape::point(0.0);
-    };
     // Pass 1: bounding box and the points attaining it.
-    let mut lo = first;
-    let mut hi = first;
-    let mut ext = [0usize; 6];
-    for (i, p) in points.iter().enumerate() {
-        for k in 0..3 {
-            if p[k] < lo[k] {
-                lo[k] = p[k];
-                ext[2 * k] = i;
+    let mut extremes = Extremes::new(points.first().copied().unwrap_or_default());
+    for (i, &p) in points.iter().enumerate() {
+        extremes.add(i, p);
+    }
+    classify_with(points, magnitude, &extremes)
+}
+
+/// The bounding box of a point set and, for each side, the first point on it (in order
+/// of [`Extremes::add`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Extremes {
+    lo: V3,
+    hi: V3,
+    /// Index of the first point attaining `lo[k]` (at `2k`) and `hi[k]` (at `2k + 1`).
+    ext: [usize; 6],
+}
+
+impl Extremes {
+    /// The extremes of the set `{first}` (point 0).
+    pub(crate) fn new(first: V3) -> Extremes {
+        Extremes {
+            lo: first,
+            hi: first,
+            ext: [0; 6],
+        }
+    }
+
+    /// Takes point `i` into account; points must be added in index order.
+    #[inline(always)]
+    pub(crate) fn add(&mut self, i: usize, p: V3) {
+        for (k, &x) in p.iter().enumerate() {
+            if x < self.lo[k] {
+                self.lo[k] = x;
+                self.ext[2 * k] = i;
             }
-            if p[k] > hi[k] {
-                hi[k] = p[k];
-                ext[2 * k + 1] = i;
+            if x > self.hi[k] {
+                self.hi[k] = x;
+                self.ext[2 * k + 1] = i;
             }
         }
     }
+}
+
+/// [`classify`], given the [`Extremes`] of `points` (added in order).
+pub(crate) fn classify_with(points: &[V3], magnitude: f64, extremes: &Extremes) -> Shape {
+    let Some(&first) = points.first() else {
+        return Shape::point(0.0);
+    };
+    let Extremes { lo, hi, ext } = *extremes;
     let diameter = norm2(sub(hi, lo)).sqrt();
     if !diameter.is_finite() || diameter <= POINT_TOLERANCE * magnitude || diameter == 0.0 {
         return Shape::point(if diameter.is_finite() { diameter } else { 0.0 });

@@ -9,7 +9,7 @@
 use nalgebra::Matrix3;
 
 use super::covariance::{Moments, Sym3};
-use super::dimension::{classify, Shape};
+use super::dimension::{classify_with, Shape};
 use super::eigen::{axes2, axes3};
 use super::frame::{finish, Frame};
 use super::hull::{is_flat, plane_basis};
@@ -47,7 +47,7 @@ pub(crate) fn fit(
         }
     }
     s.gather(positions, faces, method == FitMethod::Vertices);
-    let shape = classify(&s.pts, s.magnitude);
+    let shape = classify_with(&s.pts, s.magnitude, &s.extremes);
     match shape.dim {
         0 => return Matrix3::identity(),
         1 => {

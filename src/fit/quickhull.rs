@@ -182,7 +182,10 @@ impl QuickHull {
     fn seed(&mut self, points: &[V3], s: [usize; 4], eps: f64) -> Result<(), QuickHullError> {
         for (k, (v, adj)) in seed_faces(points, s)?.into_iter().enumerate() {
             let f = self.new_face(points, v, eps)?;
-            let face = self.faces.get_mut(f as usize).ok_or(QuickHullError::Input)?;
+            let face = self
+                .faces
+                .get_mut(f as usize)
+                .ok_or(QuickHullError::Input)?;
             if f as usize != k {
                 return Err(QuickHullError::Input);
             }

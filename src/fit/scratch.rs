@@ -4,6 +4,7 @@
 //! buffers each time would dominate. Each thread keeps one [`Scratch`] (see
 //! `principal_axes`), sized by the largest input it has seen.
 
+use super::dimension::Extremes;
 use super::hull::HullScratch;
 use super::vec3::V3;
 
@@ -21,6 +22,8 @@ pub(crate) struct Scratch {
     pub(crate) ids: Vec<u32>,
     /// Largest absolute coordinate before centring (sets the "single point" floor).
     pub(crate) magnitude: f64,
+    /// The bounding box of `pts` (after centring) and the points on it.
+    pub(crate) extremes: Extremes,
     /// Convex-hull buffers.
     pub(crate) hull: HullScratch,
 }
@@ -70,7 +73,8 @@ impl Scratch {
         self.center();
     }
 
-    /// Centres the points at their bounding-box centre; records the magnitude.
+    /// Centres the points at their bounding-box centre; records the magnitude and the
+    /// extremes of the centred points.
     fn center(&mut self) {
         let Some(&first) = self.pts.first() else {
             self.magnitude = 0.0;
@@ -90,8 +94,12 @@ impl Scratch {
             magnitude = magnitude.max(lo[k].abs()).max(hi[k].abs());
         }
         self.magnitude = magnitude;
-        for p in &mut self.pts {
-            *p = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let centred = |p: V3| [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let mut extremes = Extremes::new(centred(first));
+        for (i, p) in self.pts.iter_mut().enumerate() {
+            *p = centred(*p);
+            extremes.add(i, *p);
         }
+        self.extremes = extremes;
     }
 }
