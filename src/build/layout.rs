@@ -2,7 +2,7 @@
 //! reference, and gather the statistics that `info` reads from the header.
 
 use super::topdown::DraftTree;
-use super::{BuildError, BuiltTree};
+use super::BuiltTree;
 use crate::bv::BoundingVolume;
 use crate::mesh::triangle_is_degenerate;
 use crate::tree::{Encoding, NodeRef};
@@ -69,45 +69,52 @@ impl TreeStats {
     }
 }
 
+/// The finished arrays and header statistics of a built tree. `degenerate_triangles` and
+/// the vertex `bounds` do not depend on the tree, so the caller finds them while the tree
+/// is being built.
 pub(crate) fn finish<B: BoundingVolume>(
     draft: DraftTree<B>,
     vertices: Vec<[B::Real; 3]>,
-    positions: &[[f64; 3]],
-) -> Result<BuiltTree<B>, BuildError> {
+    degenerate_triangles: u32,
+    (bounds_min, bounds_max): ([f64; 3], [f64; 3]),
+) -> BuiltTree<B> {
+    let shape = draft.shape;
     let node_count = draft.node_count();
-    let (mut stats, binary) = TreeStats::of_nodes(draft.drafts().map(|d| d.refs), node_count)
-        .expect("the builder lays children out after their parent");
-    let encoding = if binary {
+    // Every internal node has two children, so single-face leaves make a binary tree.
+    // (An empty mesh is one leaf of no faces, which only the variable encoding holds.)
+    let encoding = if shape.max_leaf_faces == 1 {
         Encoding::Binary
     } else {
         Encoding::Variable
     };
-    // Only the packed references are made here: the writer pairs them with the drafts'
-    // volumes as it encodes the nodes, so the node array is never copied.
-    let packed = draft
-        .drafts()
-        .map(|d| encoding.encode(d.refs))
-        .collect::<Result<Vec<u32>, _>>()?;
-    stats.degenerate_triangles = draft
-        .faces
+    let stats = TreeStats {
+        leaves: shape.leaves,
+        depth: shape.depth,
+        max_leaf_faces: shape.max_leaf_faces,
+        degenerate_triangles,
+        bounds_min,
+        bounds_max,
+    };
+    BuiltTree {
+        vertices,
+        faces: draft.faces,
+        source_ids: draft.source_ids,
+        node_count,
+        nodes: draft.pieces,
+        encoding,
+        stats,
+    }
+}
+
+/// Number of triangles of zero area (exactly zero cross product of their corners).
+pub(crate) fn degenerate_count(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> u32 {
+    faces
         .iter()
         .filter(|f| {
             let corner = |k: usize| positions.get(f[k] as usize).copied().unwrap_or_default();
             triangle_is_degenerate(corner(0), corner(1), corner(2))
         })
-        .count() as u32;
-    let (lo, hi) = bounds(positions);
-    stats.bounds_min = lo;
-    stats.bounds_max = hi;
-    Ok(BuiltTree {
-        vertices,
-        faces: draft.faces,
-        source_ids: draft.source_ids,
-        nodes: draft.pieces,
-        packed,
-        encoding,
-        stats,
-    })
+        .count() as u32
 }
 
 /// Componentwise extremes of `points` (zeros for none).

@@ -118,9 +118,18 @@ fn build_as<B: BoundingVolume>(
         .map(|p| p.map(<B::Real as Real>::from_f64_nearest))
         .collect();
     let positions: Vec<[f64; 3]> = stored.iter().map(crate::real::point_to_f64).collect();
-    let draft = topdown::build_drafts::<B>(&positions, mesh.faces(), options, progress);
-    let tree = layout::finish(draft, stored, &positions)?;
-    Ok(format::serialize(&tree, options))
+    // The statistics that do not depend on the tree are found alongside it.
+    let (draft, (degenerate, bounds)) = rayon::join(
+        || topdown::build_drafts::<B>(&positions, mesh.faces(), options, progress),
+        || {
+            (
+                layout::degenerate_count(&positions, mesh.faces()),
+                bounds_of(&positions),
+            )
+        },
+    );
+    let tree = layout::finish(draft, stored, degenerate, bounds);
+    Ok(format::serialize(&tree, options)?)
 }
 
 /// A finished tree in memory: the arrays of the file, before serialization.
@@ -129,10 +138,10 @@ pub(crate) struct BuiltTree<B: BoundingVolume> {
     pub vertices: Vec<[B::Real; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
-    /// The nodes' volumes (with their references before packing), in pieces.
+    /// The nodes, in pieces.
     pub nodes: Vec<topdown::Piece<B>>,
-    /// The packed reference of each node, in `encoding`.
-    pub packed: Vec<u32>,
+    /// Number of nodes.
+    pub node_count: usize,
     pub encoding: crate::tree::Encoding,
     pub stats: TreeStats,
 }

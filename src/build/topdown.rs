@@ -37,8 +37,10 @@ impl<B> Draft<B> {
 /// The drafts of a whole tree (node 0 the root, children of a node adjacent and after it),
 /// and the faces and their input ids permuted into leaf order.
 pub(crate) struct DraftTree<B> {
-    /// The node array in consecutive pieces (see [`DraftTree::drafts`]).
+    /// The node array as consecutive pieces (see [`Piece`]).
     pub pieces: Vec<Piece<B>>,
+    /// Leaf statistics of the tree.
+    pub shape: Shape,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
 }
@@ -48,10 +50,34 @@ impl<B: Copy> DraftTree<B> {
     pub fn node_count(&self) -> usize {
         self.pieces.iter().map(Piece::len).sum()
     }
+}
 
-    /// Every node in order, with final child indices.
-    pub fn drafts(&self) -> impl Iterator<Item = Draft<B>> + '_ {
-        self.pieces.iter().flat_map(Piece::drafts)
+/// What the file header records of a tree's leaves, gathered as the tree is built.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Shape {
+    /// Number of leaves.
+    pub leaves: u32,
+    /// Nodes on the longest root-to-leaf path.
+    pub depth: u32,
+    /// Most faces in one leaf.
+    pub max_leaf_faces: u32,
+}
+
+impl Shape {
+    /// Counts a leaf of `faces` triangles at `depth` (the root at 1).
+    fn leaf(&mut self, depth: u32, faces: u32) {
+        self.leaves += 1;
+        self.depth = self.depth.max(depth);
+        self.max_leaf_faces = self.max_leaf_faces.max(faces);
+    }
+
+    /// A parent over subtrees of these shapes.
+    fn parent(left: Shape, right: Shape) -> Shape {
+        Shape {
+            leaves: left.leaves + right.leaves,
+            depth: 1 + left.depth.max(right.depth),
+            max_leaf_faces: left.max_leaf_faces.max(right.max_leaf_faces),
+        }
     }
 }
 
@@ -75,12 +101,6 @@ impl<B: Copy> Piece<B> {
     pub fn raw(&self) -> (&[Draft<B>], u32) {
         (self.drafts.get(self.skip..).unwrap_or_default(), self.shift)
     }
-
-    /// The nodes, with final child indices.
-    pub fn drafts(&self) -> impl ExactSizeIterator<Item = Draft<B>> + '_ {
-        let (drafts, shift) = self.raw();
-        drafts.iter().map(move |d| d.shifted(shift))
-    }
 }
 
 /// Nodes with at least this many triangles have their halves built as separate tasks;
@@ -95,10 +115,11 @@ const PARALLEL_MAX_DEPTH: u32 = 20;
 /// A subtree as built: one task's drafts in local layout (root at 0), or a node split
 /// into two tasks with the subtrees of its halves.
 enum Subtree<B> {
-    Serial(Vec<Draft<B>>),
+    Serial(Vec<Draft<B>>, Shape),
     Split {
         bv: B,
         len: usize,
+        shape: Shape,
         left: Box<Subtree<B>>,
         right: Box<Subtree<B>>,
     },
@@ -107,8 +128,14 @@ enum Subtree<B> {
 impl<B: Copy> Subtree<B> {
     fn len(&self) -> usize {
         match self {
-            Subtree::Serial(drafts) => drafts.len(),
+            Subtree::Serial(drafts, _) => drafts.len(),
             Subtree::Split { len, .. } => *len,
+        }
+    }
+
+    fn shape(&self) -> Shape {
+        match self {
+            Subtree::Serial(_, shape) | Subtree::Split { shape, .. } => *shape,
         }
     }
 
@@ -123,7 +150,7 @@ impl<B: Copy> Subtree<B> {
     /// Appends the root, for a subtree whose non-root nodes go at `base + local index`.
     fn place_root(&self, base: u32, pieces: &mut Vec<Piece<B>>) {
         let root = match self {
-            Subtree::Serial(drafts) => match drafts.first() {
+            Subtree::Serial(drafts, _) => match drafts.first() {
                 Some(d) => d.shifted(base),
                 None => return,
             },
@@ -145,7 +172,7 @@ impl<B: Copy> Subtree<B> {
     /// Appends every node but the root (see [`Subtree::place_root`]).
     fn place_rest(self, base: u32, pieces: &mut Vec<Piece<B>>) {
         match self {
-            Subtree::Serial(drafts) => {
+            Subtree::Serial(drafts, _) => {
                 if drafts.len() > 1 {
                     pieces.push(Piece {
                         drafts,
@@ -187,10 +214,12 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
         progress,
     };
     let tree = build_parallel::<B>(&ctx, &mut faces, &mut source_ids, 0, 0);
+    let shape = tree.shape();
     let mut pieces = Vec::new();
     tree.place(&mut pieces);
     DraftTree {
         pieces,
+        shape,
         faces,
         source_ids,
     }
@@ -290,18 +319,22 @@ fn build_parallel<B: BoundingVolume>(
     depth: u32,
 ) -> Subtree<B> {
     if depth >= PARALLEL_MAX_DEPTH || faces.len() < PARALLEL_MIN_FACES {
-        return Subtree::Serial(build_serial(ctx, faces, ids, face_offset));
+        let (drafts, shape) = build_serial(ctx, faces, ids, face_offset);
+        return Subtree::Serial(drafts, shape);
     }
     let mut scratch = Scratch::default();
     let (bv, split) = fit_and_split::<B>(ctx, faces, ids, &mut scratch);
     let Some(mid) = split else {
-        return Subtree::Serial(vec![Draft {
+        let mut shape = Shape::default();
+        shape.leaf(1, faces.len() as u32);
+        let leaf = Draft {
             bv,
             refs: NodeRef::Leaf {
                 first: face_offset,
                 count: faces.len() as u32,
             },
-        }]);
+        };
+        return Subtree::Serial(vec![leaf], shape);
     };
     let (fl, fr) = faces.split_at_mut(mid);
     let (il, ir) = ids.split_at_mut(mid);
@@ -312,6 +345,7 @@ fn build_parallel<B: BoundingVolume>(
     Subtree::Split {
         bv,
         len: 1 + left.len() + right.len(),
+        shape: Shape::parent(left.shape(), right.shape()),
         left: Box::new(left),
         right: Box::new(right),
     }
@@ -324,15 +358,17 @@ fn build_serial<B: BoundingVolume>(
     faces: &mut [[u32; 3]],
     ids: &mut [u32],
     face_offset: u32,
-) -> Vec<Draft<B>> {
+) -> (Vec<Draft<B>>, Shape) {
     let placeholder = Draft {
         bv: B::new_zeroed(),
         refs: NodeRef::Leaf { first: 0, count: 0 },
     };
     let mut nodes = vec![placeholder];
-    let mut stack = vec![(0usize, 0usize, faces.len())];
+    let mut shape = Shape::default();
+    // (node, faces start, faces end, depth)
+    let mut stack = vec![(0usize, 0usize, faces.len(), 1u32)];
     let mut scratch = Scratch::default();
-    while let Some((slot, start, end)) = stack.pop() {
+    while let Some((slot, start, end, depth)) = stack.pop() {
         let (bv, split) = fit_and_split::<B>(
             ctx,
             &mut faces[start..end],
@@ -340,17 +376,20 @@ fn build_serial<B: BoundingVolume>(
             &mut scratch,
         );
         let refs = match split {
-            None => NodeRef::Leaf {
-                first: face_offset + start as u32,
-                count: (end - start) as u32,
-            },
+            None => {
+                shape.leaf(depth, (end - start) as u32);
+                NodeRef::Leaf {
+                    first: face_offset + start as u32,
+                    count: (end - start) as u32,
+                }
+            }
             Some(mid) => {
                 let first = nodes.len();
                 nodes.push(placeholder);
                 nodes.push(placeholder);
                 // Right pushed first so the left subtree is laid out first.
-                stack.push((first + 1, start + mid, end));
-                stack.push((first, start, start + mid));
+                stack.push((first + 1, start + mid, end, depth + 1));
+                stack.push((first, start, start + mid, depth + 1));
                 NodeRef::Internal {
                     first: first as u32,
                     count: 2,
@@ -359,5 +398,5 @@ fn build_serial<B: BoundingVolume>(
         };
         nodes[slot] = Draft { bv, refs };
     }
-    nodes
+    (nodes, shape)
 }

@@ -9,6 +9,7 @@ use super::open::ObbtFile;
 use crate::build::{BuildOptions, BuiltTree};
 use crate::bv::{BoundingVolume, Node};
 use crate::real::{Precision, Real};
+use crate::tree::EncodeError;
 use rayon::prelude::*;
 use std::io::Write;
 use std::ops::Range;
@@ -20,10 +21,12 @@ use zerocopy::IntoBytes;
 ///
 /// Every section is encoded straight into its place in the (zero-initialised) image, so the
 /// image is the only large buffer the writer touches.
+///
+/// Fails if a node reference does not fit the tree's encoding.
 pub(crate) fn serialize<B: BoundingVolume>(
     tree: &BuiltTree<B>,
     options: &BuildOptions,
-) -> ObbtFile {
+) -> Result<ObbtFile, EncodeError> {
     let scalar = std::mem::size_of::<B::Real>();
     // (kind, count, stride) in file order; the byte length of each is count * stride.
     let sections = [
@@ -36,7 +39,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         (SectionKind::SourceIds, tree.source_ids.len() as u64, 4),
         (
             SectionKind::Nodes,
-            tree.packed.len() as u64,
+            tree.node_count as u64,
             Node::<B>::SIZE as u32,
         ),
     ];
@@ -64,7 +67,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
     for (out, i) in ids.chunks_exact_mut(4).zip(&tree.source_ids) {
         out.copy_from_slice(&i.to_le_bytes());
     }
-    let nodes_crc = write_nodes(tree, nodes);
+    let nodes_crc = write_nodes(tree, nodes)?;
 
     let entries: Vec<SectionEntry> = sections
         .iter()
@@ -98,7 +101,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         section_count: (sections.len() as u16).into(),
         triangles: (tree.faces.len() as u32).into(),
         vertices: (tree.vertices.len() as u32).into(),
-        nodes: (tree.packed.len() as u32).into(),
+        nodes: (tree.node_count as u32).into(),
         leaves: s.leaves.into(),
         depth: s.depth.into(),
         degenerate_triangles: s.degenerate_triangles.into(),
@@ -116,50 +119,50 @@ pub(crate) fn serialize<B: BoundingVolume>(
     header.header_crc = header_crc(header.as_bytes(), &directory).into();
     bytes[..HEADER_SIZE].copy_from_slice(header.as_bytes());
     bytes[HEADER_SIZE..header_bytes].copy_from_slice(&directory);
-    ObbtFile::from_aligned(image).expect("the writer lays out a valid header and directory")
+    Ok(ObbtFile::from_aligned(image).expect("the writer lays out a valid header and directory"))
 }
 
 /// Encodes the nodes of `tree` into `out` (exactly their size) and returns its CRC-32.
 ///
 /// The nodes are most of the file: they are encoded in parallel, in runs of at most
 /// `CHUNK` nodes (cut at the same places whatever the number of threads), each run's CRC
-/// taken while its bytes are still in cache and the CRCs combined in order.
-fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> u32 {
+/// taken while its bytes are still in cache and the CRCs combined in order. The first
+/// reference (in node order) that the encoding cannot hold is the error.
+fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result<u32, EncodeError> {
     const CHUNK: usize = 2048;
     let size = Node::<B>::SIZE;
-    // (drafts, packed references, output) of each run, in order. The references are
-    // already packed, so the drafts' own (unshifted) ones are not needed.
+    // (drafts, their shift, output) of each run, in order.
     let mut runs = Vec::new();
-    let (mut out, mut packed) = (out, tree.packed.as_slice());
+    let mut out = out;
     for piece in &tree.nodes {
-        for drafts in piece.raw().0.chunks(CHUNK) {
-            let n = drafts.len();
-            let (o, rest) = std::mem::take(&mut out).split_at_mut(n * size);
-            let (p, rest_packed) = packed.split_at(n);
-            runs.push((drafts, p, o));
+        let (drafts, shift) = piece.raw();
+        for drafts in drafts.chunks(CHUNK) {
+            let (o, rest) = std::mem::take(&mut out).split_at_mut(drafts.len() * size);
+            runs.push((drafts, shift, o));
             out = rest;
-            packed = rest_packed;
         }
     }
-    let hashers: Vec<crc32fast::Hasher> = runs
+    let encoding = tree.encoding;
+    let hashers: Vec<Result<crc32fast::Hasher, EncodeError>> = runs
         .into_par_iter()
-        .map(|(drafts, packed, out)| {
+        .map(|(drafts, shift, out)| {
             let mut record = Vec::with_capacity(size);
-            for ((out, d), &p) in out.chunks_exact_mut(size).zip(drafts).zip(packed) {
+            for (out, d) in out.chunks_exact_mut(size).zip(drafts) {
+                let packed = encoding.encode(d.shifted(shift).refs)?;
                 record.clear();
-                Node::new(d.bv, p).write_le(&mut record);
+                Node::new(d.bv, packed).write_le(&mut record);
                 out.copy_from_slice(&record);
             }
             let mut h = crc32fast::Hasher::new();
             h.update(out);
-            h
+            Ok(h)
         })
         .collect();
     let mut crc = crc32fast::Hasher::new();
-    for h in &hashers {
-        crc.combine(h);
+    for h in hashers {
+        crc.combine(&h?);
     }
-    crc.finalize()
+    Ok(crc.finalize())
 }
 
 /// The four section slices of `bytes` at the (ascending, disjoint) `ranges`.
