@@ -82,12 +82,15 @@ impl<R: Real> Obb<R> {
         let mut hi = [f64::NEG_INFINITY; 3];
         let mut l1_max = 0.0f64;
         for p in points {
+            // Plain comparisons (not `f64::min`, which must also handle NaN): one
+            // instruction each on the hottest loop of a build.
             for i in 0..3 {
                 let d = dot(&a[i], p);
-                lo[i] = lo[i].min(d);
-                hi[i] = hi[i].max(d);
+                lo[i] = if d < lo[i] { d } else { lo[i] };
+                hi[i] = if d > hi[i] { d } else { hi[i] };
             }
-            l1_max = l1_max.max(l1(p));
+            let m = l1(p);
+            l1_max = if m > l1_max { m } else { l1_max };
         }
         if !lo[0].is_finite() {
             // No vertices (callers never do this): an empty box at the origin.

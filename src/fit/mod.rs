@@ -141,8 +141,10 @@ pub(crate) fn principal_axes_and_vertices(
     vertices: &mut Vec<u32>,
 ) -> Matrix3<f64> {
     vertices.clear();
+    if let [face] = faces {
+        vertices.extend_from_slice(face);
+    }
     if faces.len() <= 1 {
-        vertices.extend(faces.iter().flatten().copied());
         return principal_axes(method, positions, faces);
     }
     let frame = with_scratch(|s| {

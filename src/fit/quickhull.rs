@@ -596,9 +596,13 @@ impl Face {
 fn broken_edge(face: &Face, normal: V3, far: V3, limit: f64, flat: f64) -> bool {
     let d = dot(face.normal, far) - face.offset;
     let len2 = norm2(face.normal);
-    let reflex = d > 0.0 && d * d > limit * len2;
-    let folded = d * d <= flat * len2 && dot(face.normal, normal) < 0.0;
-    reflex || folded
+    let d2 = d * d;
+    if d > 0.0 && d2 > limit * len2 {
+        return true; // reflex
+    }
+    // Folded: flat against the face with opposed normals (the dot product is only needed
+    // for the rare nearly flat edge).
+    d2 <= flat * len2 && dot(face.normal, normal) < 0.0
 }
 
 /// The faces of the tetrahedron on `s` (indices into `points`), counter-clockwise seen
