@@ -127,13 +127,13 @@ impl QuickHull {
         self.faces.clear();
         self.free.clear();
         self.pending.clear();
-        self.next.clear();
-        self.next.resize(n, NONE);
-        self.slot.clear();
-        self.slot.resize(n, NONE);
-        self.slot_mark.clear();
-        self.slot_mark.resize(n, 0);
-        self.chain = 0;
+        // Per-point buffers need no clearing: `next` is written before it is read, `slot`
+        // is only read where `slot_mark` holds the current stamp, and stamps only grow.
+        if self.next.len() < n {
+            self.next.resize(n, NONE);
+            self.slot.resize(n, NONE);
+            self.slot_mark.resize(n, 0);
+        }
         self.iteration = 0;
 
         self.seed(points, simplex, eps)?;
