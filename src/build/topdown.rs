@@ -7,8 +7,9 @@
 
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
-use crate::fit::principal_axes_and_vertices;
+use crate::fit::{principal_axes, principal_axes_and_vertices, FitMethod};
 use crate::tree::NodeRef;
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A node during construction: indices are local to the subtree being built until merged.
@@ -95,6 +96,20 @@ impl<B: Copy> Piece<B> {
     /// Number of nodes.
     pub fn len(&self) -> usize {
         self.drafts.len().saturating_sub(self.skip)
+    }
+
+    /// Sets the volume of every single-face leaf to that of its face: `volumes` by input
+    /// face id, `source_ids` the input id of each leaf-ordered face.
+    fn fill_leaves(&mut self, volumes: &[B], source_ids: &[u32]) {
+        let skip = self.skip;
+        for d in self.drafts.iter_mut().skip(skip) {
+            if let NodeRef::Leaf { first, count: 1 } = d.refs {
+                let id = source_ids.get(first as usize).copied();
+                if let Some(&bv) = id.and_then(|id| volumes.get(id as usize)) {
+                    d.bv = bv;
+                }
+            }
+        }
     }
 
     /// The nodes as built, and what to add to their child indices.
@@ -198,31 +213,66 @@ struct Context<'a> {
     positions: &'a [[f64; 3]],
     options: &'a BuildOptions,
     progress: Option<&'a AtomicU64>,
+    /// Single-face leaves get their volumes later, from `leaf_volume` (a placeholder until
+    /// then).
+    defer_leaves: bool,
 }
 
 pub(crate) fn build_drafts<B: BoundingVolume>(
     positions: &[[f64; 3]],
-    faces: &[[u32; 3]],
+    input_faces: &[[u32; 3]],
     options: &BuildOptions,
     progress: Option<&AtomicU64>,
 ) -> DraftTree<B> {
-    let mut faces = faces.to_vec();
+    let mut faces = input_faces.to_vec();
     let mut source_ids: Vec<u32> = (0..faces.len() as u32).collect();
+    // A single-face leaf's volume depends on its triangle alone, not on the tree. With
+    // leaf size 1 every triangle becomes such a leaf, so their volumes are computed
+    // apart, alongside the tree: that work keeps the second core busy while the first
+    // is still fitting the root, which nothing else can start before.
+    let defer_leaves = options.leaf_size == 1;
     let ctx = Context {
         positions,
         options,
         progress,
+        defer_leaves,
     };
-    let tree = build_parallel::<B>(&ctx, &mut faces, &mut source_ids, 0, 0);
+    let (tree, leaf_volumes) = if defer_leaves {
+        let (tree, volumes) = rayon::join(
+            || build_parallel::<B>(&ctx, &mut faces, &mut source_ids, 0, 0),
+            || {
+                input_faces
+                    .par_iter()
+                    .map(|f| leaf_volume::<B>(options.fit, positions, f))
+                    .collect::<Vec<B>>()
+            },
+        );
+        (tree, Some(volumes))
+    } else {
+        let tree = build_parallel::<B>(&ctx, &mut faces, &mut source_ids, 0, 0);
+        (tree, None)
+    };
     let shape = tree.shape();
     let mut pieces = Vec::new();
     tree.place(&mut pieces);
+    if let Some(volumes) = leaf_volumes {
+        pieces
+            .par_iter_mut()
+            .for_each(|piece| piece.fill_leaves(&volumes, &source_ids));
+    }
     DraftTree {
         pieces,
         shape,
         faces,
         source_ids,
     }
+}
+
+/// The volume of a leaf holding just `face`: exactly what the builder computes for such
+/// a node.
+fn leaf_volume<B: BoundingVolume>(fit: FitMethod, positions: &[[f64; 3]], face: &[u32; 3]) -> B {
+    let axes = principal_axes(fit, positions, std::slice::from_ref(face));
+    B::enclose_vertices(&axes, positions, face)
 }
 
 /// Buffers reused from node to node by one task.
@@ -242,6 +292,12 @@ fn fit_and_split<B: BoundingVolume>(
     ids: &mut [u32],
     scratch: &mut Scratch,
 ) -> (B, Option<usize>) {
+    if ctx.defer_leaves && faces.len() == 1 {
+        if let Some(p) = ctx.progress {
+            p.fetch_add(1, Ordering::Relaxed);
+        }
+        return (B::new_zeroed(), None);
+    }
     let axes =
         principal_axes_and_vertices(ctx.options.fit, ctx.positions, faces, &mut scratch.vertices);
     let bv = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
