@@ -1,7 +1,10 @@
 //! Oriented bounding box (dissertation §3.2).
 
 use super::pair::{box_pair_methods, BoxPair, Transform};
-use super::{all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect, BvKind};
+use super::{
+    all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
+    BvKind,
+};
 use crate::real::{point_to_f64, Precision, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
