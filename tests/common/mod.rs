@@ -39,13 +39,21 @@ pub fn uv_sphere(radius: f64, stacks: u32, slices: u32) -> TriMesh {
 
 /// The axis-aligned cube `[-h, h]^3`, 12 triangles.
 pub fn cube(h: f64) -> TriMesh {
+    cuboid([h, h, h], [0.0; 3])
+}
+
+/// The axis-aligned box with half-widths `half` centred at `center`, 12 triangles, outward
+/// normals. Corner `i` has the upper coordinate on axis `k` when bit `k` of `i` is set.
+pub fn cuboid(half: [f64; 3], center: [f64; 3]) -> TriMesh {
     let v: Vec<[f64; 3]> = (0..8)
         .map(|i| {
-            [
-                if i & 1 == 0 { -h } else { h },
-                if i & 2 == 0 { -h } else { h },
-                if i & 4 == 0 { -h } else { h },
-            ]
+            std::array::from_fn(|k| {
+                if i & (1 << k) == 0 {
+                    center[k] - half[k]
+                } else {
+                    center[k] + half[k]
+                }
+            })
         })
         .collect();
     let faces = vec![
@@ -62,7 +70,7 @@ pub fn cube(h: f64) -> TriMesh {
         [1, 3, 5],
         [3, 7, 5],
     ];
-    TriMesh::new(v, faces).expect("valid cube")
+    TriMesh::new(v, faces).expect("valid cuboid")
 }
 
 /// A flat `n x n` grid of unit squares in the plane z = 0, `2 n^2` triangles.
