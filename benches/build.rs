@@ -17,26 +17,10 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use obbtree::build::{build, BuildOptions};
 use obbtree::fit::FitMethod;
 use obbtree::format::ObbtFile;
-use obbtree::mesh::TriMesh;
-use std::path::Path;
 use std::time::Duration;
 
-fn shared_mesh(name: &str) -> Option<TriMesh> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/meshes")
-        .join(name);
-    if !path.exists() {
-        eprintln!(
-            "skipping benchmarks on {name}: {} not found",
-            path.display()
-        );
-        return None;
-    }
-    Some(TriMesh::load(&path).expect("shared mesh loads"))
-}
-
 fn build_throughput(c: &mut Criterion) {
-    let Some(bunny) = shared_mesh("bunny.obj") else {
+    let Some(bunny) = common::shared_mesh("bunny.obj") else {
         return;
     };
     let mut group = c.benchmark_group("build");

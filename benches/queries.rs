@@ -12,48 +12,21 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[path = "support/parry.rs"]
+mod parry_support;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use obbtree::mesh::TriMesh;
 use obbtree::query::{
     collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
 };
 use parry3d::bounding_volume::BoundingVolume as _;
-use parry3d::math::{Pose as PPose, Vector as PVector};
+use parry3d::math::Pose as PPose;
 use std::hint::black_box;
 
 const XS: [f64; 5] = [0.2, 0.6, 1.0, 1.4, 1.8];
 
 use common::tree_f64 as tree;
-
-fn parry_mesh(mesh: &TriMesh) -> parry3d::shape::TriMesh {
-    let v = mesh
-        .vertices()
-        .iter()
-        .map(|p| PVector::new(p[0] as f32, p[1] as f32, p[2] as f32))
-        .collect();
-    parry3d::shape::TriMesh::new(v, mesh.faces().to_vec()).expect("parry accepts the mesh")
-}
-
-fn parry_pose(p: &Pose) -> PPose {
-    let r = p.rotation();
-    let m = glam::Mat3::from_cols_array(&[
-        r[(0, 0)] as f32,
-        r[(1, 0)] as f32,
-        r[(2, 0)] as f32,
-        r[(0, 1)] as f32,
-        r[(1, 1)] as f32,
-        r[(2, 1)] as f32,
-        r[(0, 2)] as f32,
-        r[(1, 2)] as f32,
-        r[(2, 2)] as f32,
-    ]);
-    let t = p.translation_vector();
-    PPose::from_parts(
-        PVector::new(t.x as f32, t.y as f32, t.z as f32),
-        glam::Quat::from_mat3(&m),
-    )
-}
+use parry_support::{parry_mesh, parry_pose};
 
 /// All intersecting triangle pairs with parry: its BVH pair traversal plus its exact test.
 fn parry_all_pairs(

@@ -101,6 +101,22 @@ pub fn cow() -> TriMesh {
     .expect("assets/cow.obj loads")
 }
 
+/// A mesh of `../shared/meshes` (outside the repository, for benchmarks), or `None` with a
+/// message on stderr when it is missing.
+pub fn shared_mesh(name: &str) -> Option<TriMesh> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/meshes")
+        .join(name);
+    if !path.exists() {
+        eprintln!(
+            "skipping benchmarks on {name}: {} not found",
+            path.display()
+        );
+        return None;
+    }
+    Some(TriMesh::load(&path).expect("shared mesh loads"))
+}
+
 /// Every option combination the format supports, at leaf sizes 1 and 4.
 pub fn all_options() -> Vec<obbtree::build::BuildOptions> {
     use obbtree::build::BuildOptions;
