@@ -5,6 +5,13 @@
 //! never know where the bytes came from. Every accessor is checked: a corrupt, unverified
 //! file yields `None` (and so an error or a wrong-but-safe answer upstream), never a panic.
 
+// Packed references come from untrusted files: on top of the crate's no-panic lints,
+// integer arithmetic must be checked or saturating and narrowing casts must be `try_from`.
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::cast_possible_truncation)
+)]
+
 use crate::bv::{BoundingVolume, Node};
 use crate::real::point_to_f64;
 use std::ops::Range;
@@ -47,7 +54,8 @@ impl NodeRef {
         let (first, count) = match self {
             NodeRef::Internal { first, count } | NodeRef::Leaf { first, count } => (first, count),
         };
-        u64::from(first)..u64::from(first) + u64::from(count)
+        // Two `u32`s: the sum cannot overflow a `u64`.
+        u64::from(first)..u64::from(first).saturating_add(u64::from(count))
     }
 }
 
@@ -145,7 +153,8 @@ impl Encoding {
                 if first == 0 || first > BINARY_MAX_CHILD {
                     return Err(too_large("child", first, BINARY_MAX_CHILD));
                 }
-                Ok((first as i64).wrapping_neg() as i32 as u32)
+                // The bits of the i32 `-first`.
+                Ok(first.wrapping_neg())
             }
             (Encoding::Binary, NodeRef::Leaf { first, count }) => {
                 if count != 1 {
@@ -163,7 +172,7 @@ impl Encoding {
                 if first > VARIABLE_MAX_CHILD {
                     return Err(too_large("child", first, VARIABLE_MAX_CHILD));
                 }
-                Ok(first | ((count - 1) << 25))
+                Ok(first | (count.saturating_sub(1) << 25))
             }
             (Encoding::Variable, NodeRef::Leaf { first, count }) => {
                 if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&count) {
@@ -172,7 +181,7 @@ impl Encoding {
                 if first > VARIABLE_MAX_FACE {
                     return Err(too_large("face", first, VARIABLE_MAX_FACE));
                 }
-                Ok(LEAF_BIT | first | ((count - 1) << 24))
+                Ok(LEAF_BIT | first | (count.saturating_sub(1) << 24))
             }
         }
     }
@@ -200,12 +209,13 @@ impl Encoding {
                 if packed & LEAF_BIT != 0 {
                     NodeRef::Leaf {
                         first: packed & VARIABLE_MAX_FACE,
-                        count: ((packed >> 24) & 0x7f) + 1,
+                        // A 7-bit field plus one: no overflow.
+                        count: ((packed >> 24) & 0x7f).saturating_add(1),
                     }
                 } else {
                     NodeRef::Internal {
                         first: packed & VARIABLE_MAX_CHILD,
-                        count: ((packed >> 25) & 0x3f) + 1,
+                        count: ((packed >> 25) & 0x3f).saturating_add(1),
                     }
                 }
             }

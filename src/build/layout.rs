@@ -3,6 +3,7 @@
 
 use super::topdown::DraftTree;
 use super::BuiltTree;
+use crate::arr3;
 use crate::bv::BoundingVolume;
 use crate::mesh::triangle_is_degenerate;
 use crate::tree::{Encoding, NodeRef};
@@ -111,8 +112,10 @@ pub(crate) fn degenerate_count(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> u3
     faces
         .iter()
         .filter(|f| {
-            let corner = |k: usize| positions.get(f[k] as usize).copied().unwrap_or_default();
-            triangle_is_degenerate(corner(0), corner(1), corner(2))
+            let [p, q, r] = arr3::map(**f, |v| {
+                positions.get(v as usize).copied().unwrap_or_default()
+            });
+            triangle_is_degenerate(p, q, r)
         })
         .count() as u32
 }
@@ -122,10 +125,8 @@ pub(crate) fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
+        lo = arr3::min(lo, *p);
+        hi = arr3::max(hi, *p);
     }
     if points.is_empty() {
         return ([0.0; 3], [0.0; 3]);

@@ -66,6 +66,10 @@ pub enum BuildError {
         /// The largest count the format holds.
         max: u64,
     },
+    /// The `.obbt` image could not be laid out in memory: it is larger than this platform
+    /// can address (32-bit hosts), or (a bug) the header written fails the reader's checks.
+    #[error("cannot lay out the .obbt image: {0}")]
+    Image(String),
 }
 
 /// Builds the tree of `mesh` and lays it out as a complete `.obbt` image in memory (the same
@@ -129,7 +133,7 @@ fn build_as<B: BoundingVolume>(
         },
     );
     let tree = layout::finish(draft, stored, degenerate, bounds);
-    Ok(format::serialize(&tree, options)?)
+    format::serialize(&tree, options)
 }
 
 /// A finished tree in memory: the arrays of the file, before serialization.

@@ -307,7 +307,8 @@ fn fit_and_split<B: BoundingVolume>(
         }
         return (bv, None);
     }
-    let axis = [axes[(0, 0)], axes[(1, 0)], axes[(2, 0)]];
+    // The first column: the axis of greatest spread.
+    let [axis, _, _]: [[f64; 3]; 3] = axes.into();
     (
         bv,
         Some(split(ctx.positions, axis, faces, ids, &mut scratch.proj)),
@@ -337,7 +338,8 @@ fn split(
     let mean = proj.iter().sum::<f64>() / proj.len() as f64;
     let (mut i, mut j) = (0, proj.len());
     while i < j {
-        if proj[i] < mean {
+        // `i < j <= proj.len()`: the lookup always succeeds.
+        if proj.get(i).is_some_and(|&x| x < mean) {
             i += 1;
         } else {
             j -= 1;
@@ -357,13 +359,25 @@ fn split(
 fn median_split(faces: &mut [[u32; 3]], ids: &mut [u32], proj: &[f64]) -> usize {
     let mid = faces.len() / 2;
     let mut order: Vec<usize> = (0..faces.len()).collect();
+    // `order` holds indices of `faces`, `ids` and `proj` (all of one length): every lookup
+    // succeeds, the fallbacks are never used.
+    let key = |k: usize| {
+        let p = proj.get(k).copied().unwrap_or(f64::NAN);
+        (p, ids.get(k).copied().unwrap_or(u32::MAX))
+    };
     order.select_nth_unstable_by(mid, |&a, &b| {
-        proj[a].total_cmp(&proj[b]).then(ids[a].cmp(&ids[b]))
+        let ((pa, ia), (pb, ib)) = (key(a), key(b));
+        pa.total_cmp(&pb).then(ia.cmp(&ib))
     });
-    let f: Vec<[u32; 3]> = order.iter().map(|&k| faces[k]).collect();
-    let d: Vec<u32> = order.iter().map(|&k| ids[k]).collect();
-    faces.copy_from_slice(&f);
-    ids.copy_from_slice(&d);
+    let f: Vec<[u32; 3]> = order
+        .iter()
+        .filter_map(|&k| faces.get(k).copied())
+        .collect();
+    let d: Vec<u32> = order.iter().filter_map(|&k| ids.get(k).copied()).collect();
+    if f.len() == faces.len() && d.len() == ids.len() {
+        faces.copy_from_slice(&f);
+        ids.copy_from_slice(&d);
+    }
     mid
 }
 
@@ -425,12 +439,14 @@ fn build_serial<B: BoundingVolume>(
     let mut stack = vec![(0usize, 0usize, faces.len(), 1u32)];
     let mut scratch = Scratch::default();
     while let Some((slot, start, end, depth)) = stack.pop() {
-        let (bv, split) = fit_and_split::<B>(
-            ctx,
-            &mut faces[start..end],
-            &mut ids[start..end],
-            &mut scratch,
-        );
+        // Ranges and slots come from this loop's own splits, so they are always in bounds;
+        // a miss would leave a placeholder node, which the encoder refuses (count 0).
+        let (Some(node_faces), Some(node_ids)) =
+            (faces.get_mut(start..end), ids.get_mut(start..end))
+        else {
+            continue;
+        };
+        let (bv, split) = fit_and_split::<B>(ctx, node_faces, node_ids, &mut scratch);
         let refs = match split {
             None => {
                 shape.leaf(depth, (end - start) as u32);
@@ -452,7 +468,9 @@ fn build_serial<B: BoundingVolume>(
                 }
             }
         };
-        nodes[slot] = Draft { bv, refs };
+        if let Some(node) = nodes.get_mut(slot) {
+            *node = Draft { bv, refs };
+        }
     }
     (nodes, shape)
 }

@@ -2,6 +2,7 @@
 
 use super::pair::{box_pair_methods, BoxPair, Transform};
 use super::{all_finite, face_vertices, listed_vertices, BoundingVolume, BvDefect, BvKind};
+use crate::arr3;
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -39,7 +40,9 @@ impl<R: Real> Aabb<R> {
     }
 
     fn half_f64(&self) -> [f64; 3] {
-        std::array::from_fn(|i| 0.5 * (self.max[i].to_f64() - self.min[i].to_f64()))
+        arr3::map(arr3::zip(self.max, self.min), |(hi, lo)| {
+            0.5 * (hi.to_f64() - lo.to_f64())
+        })
     }
 
     /// The box of `points` (see [`BoundingVolume::enclose`]).
@@ -47,10 +50,8 @@ impl<R: Real> Aabb<R> {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in points {
-            for i in 0..3 {
-                lo[i] = lo[i].min(p[i]);
-                hi[i] = hi[i].max(p[i]);
-            }
+            lo = arr3::min(lo, *p);
+            hi = arr3::max(hi, *p);
         }
         if !lo[0].is_finite() {
             lo = [0.0; 3];
@@ -86,7 +87,10 @@ impl<R: Real> BoundingVolume for Aabb<R> {
         if !all_finite(&self.min) || !all_finite(&self.max) {
             return Err(BvDefect::NotFinite);
         }
-        if (0..3).any(|i| self.max[i].to_f64() < self.min[i].to_f64()) {
+        if arr3::zip(self.max, self.min)
+            .iter()
+            .any(|(hi, lo)| hi.to_f64() < lo.to_f64())
+        {
             return Err(BvDefect::NegativeExtent);
         }
         Ok(())
@@ -94,7 +98,9 @@ impl<R: Real> BoundingVolume for Aabb<R> {
 
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
-        (0..3).all(|i| p[i] >= lo[i] - tolerance && p[i] <= hi[i] + tolerance)
+        arr3::zip(p, arr3::zip(lo, hi))
+            .iter()
+            .all(|&(x, (lo, hi))| x >= lo - tolerance && x <= hi + tolerance)
     }
 
     box_pair_methods!();

@@ -5,6 +5,7 @@ use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
     BvKind,
 };
+use crate::arr3;
 use crate::real::{point_to_f64, Precision, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -72,6 +73,9 @@ impl<R: Real> Obb<R> {
     }
 
     /// The box of `points` along `frame`'s columns (see [`BoundingVolume::enclose`]).
+    // why: axis numbers in 0..3 on fixed-size arrays. The hottest loop of a build, kept as
+    // written: index-free forms cost 0.2-0.5% of a whole OBB build (callgrind).
+    #[allow(clippy::indexing_slicing)]
     fn enclose_points<'a>(
         frame: &Matrix3<f64>,
         points: impl Iterator<Item = &'a [f64; 3]>,
@@ -178,10 +182,10 @@ impl<R: Real> BoundingVolume for Obb<R> {
         }
         let a = self.axes_f64();
         let tol = axis_tolerance(R::PRECISION);
-        for i in 0..3 {
-            for j in 0..3 {
+        for (i, ai) in a.iter().enumerate() {
+            for (j, aj) in a.iter().enumerate() {
                 let expected = if i == j { 1.0 } else { 0.0 };
-                if (dot(&a[i], &a[j]) - expected).abs() > tol {
+                if (dot(ai, aj) - expected).abs() > tol {
                     return Err(BvDefect::AxesNotOrthonormal);
                 }
             }
@@ -194,7 +198,9 @@ impl<R: Real> BoundingVolume for Obb<R> {
         let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
         let h = self.half_f64();
         let a = self.axes_f64();
-        (0..3).all(|i| dot(&a[i], &d).abs() <= h[i] + tolerance)
+        arr3::zip(a, h)
+            .iter()
+            .all(|(axis, h)| dot(axis, &d).abs() <= h + tolerance)
     }
 
     box_pair_methods!();

@@ -75,6 +75,9 @@ impl BoxPair {
     /// to the absolute rotation entries ([`SAT_GUARD`] in queries; 0 only to demonstrate why
     /// the guard is needed). Conservative: overlapping boxes are never reported disjoint.
     #[inline]
+    // why: 3x3 matrix / 3-vector entries indexed by axis numbers in 0..3 (loop counters and
+    // their cyclic successors); the hottest test of every query, kept in the book's form.
+    #[allow(clippy::indexing_slicing)]
     pub fn disjoint(&self, guard: f64) -> bool {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs().add_scalar(guard);
@@ -116,6 +119,8 @@ impl BoxPair {
     /// rounding makes meaningless) are skipped, which only loosens the bound. 0 if the
     /// projections overlap on every axis.
     #[inline]
+    // why: as in `disjoint`, entries indexed by axis numbers in 0..3.
+    #[allow(clippy::indexing_slicing)]
     pub fn distance_lower_bound(&self) -> f64 {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs();
@@ -161,14 +166,14 @@ impl BoxPair {
         let mut best = 0.0f64;
         for corner in 0..8 {
             let p = Vector3::new(
-                if corner & 1 == 0 { -a[0] } else { a[0] },
-                if corner & 2 == 0 { -a[1] } else { a[1] },
-                if corner & 4 == 0 { -a[2] } else { a[2] },
+                if corner & 1 == 0 { -a.x } else { a.x },
+                if corner & 2 == 0 { -a.y } else { a.y },
+                if corner & 4 == 0 { -a.z } else { a.z },
             );
             let d = p - t;
             let along = m.tr_mul(&d);
             let d2 = d.norm_squared()
-                + 2.0 * (b[0] * along[0].abs() + b[1] * along[1].abs() + b[2] * along[2].abs())
+                + 2.0 * (b.x * along.x.abs() + b.y * along.y.abs() + b.z * along.z.abs())
                 + hb2;
             best = best.max(d2);
         }

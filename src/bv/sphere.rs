@@ -6,6 +6,7 @@ use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
     BvKind,
 };
+use crate::arr3;
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -41,18 +42,23 @@ impl<R: Real> Sphere<R> {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in points.clone() {
-            for i in 0..3 {
-                let d = dot(&axes[i], p);
-                lo[i] = lo[i].min(d);
-                hi[i] = hi[i].max(d);
-            }
+            let d = [dot(&axes[0], p), dot(&axes[1], p), dot(&axes[2], p)];
+            lo = arr3::min(lo, d);
+            hi = arr3::max(hi, d);
         }
         if !lo[0].is_finite() {
             lo = [0.0; 3];
             hi = [0.0; 3];
         }
-        let c: [f64; 3] =
-            std::array::from_fn(|j| (0..3).map(|i| axes[i][j] * 0.5 * (lo[i] + hi[i])).sum());
+        // c_j = Σ_i axes_i_j · ½ (lo_i + hi_i), summed over i in order.
+        let lo_hi = arr3::zip(lo, hi);
+        let c: [f64; 3] = arr3::map(arr3::transpose(axes), |column| {
+            column
+                .iter()
+                .zip(&lo_hi)
+                .map(|(x, (lo, hi))| x * 0.5 * (lo + hi))
+                .sum()
+        });
         let center = c.map(R::from_f64_nearest);
         let c = point_to_f64(&center);
         let mut r2 = 0.0f64;

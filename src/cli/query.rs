@@ -199,16 +199,14 @@ fn poses(inputs: &QueryInputs) -> Result<Option<Vec<(Pose, Pose)>>, Failure> {
         }
         let what = format!("{}:{}", path.display(), line_no + 1);
         let values = parse_numbers(line, &what)?;
-        if values.len() != 24 {
+        let Some((a, b)) = values.split_at_checked(12).filter(|_| values.len() == 24) else {
             return Err(Failure(format!(
                 "{what}: expected 24 numbers (pose A then pose B), got {}",
                 values.len()
             )));
-        }
-        let a = Pose::from_row_major(&values[..12])
-            .map_err(|e| Failure(format!("{what}: pose A: {e}")))?;
-        let b = Pose::from_row_major(&values[12..])
-            .map_err(|e| Failure(format!("{what}: pose B: {e}")))?;
+        };
+        let a = Pose::from_row_major(a).map_err(|e| Failure(format!("{what}: pose A: {e}")))?;
+        let b = Pose::from_row_major(b).map_err(|e| Failure(format!("{what}: pose B: {e}")))?;
         out.push((a, b));
     }
     Ok(Some(out))
@@ -269,8 +267,15 @@ fn witness_json(
         "stats": stats_json(stats),
         "seconds": seconds,
     });
-    out[key] = json!(value);
+    insert(&mut out, key, json!(value));
     out
+}
+
+/// Adds `key` to a JSON object (every caller's `value` is a `json!({...})` object).
+fn insert(value: &mut Value, key: &str, item: Value) {
+    if let Some(object) = value.as_object_mut() {
+        object.insert(key.to_owned(), item);
+    }
 }
 
 /// One query under one pose pair: its JSON object and its human-readable text.
@@ -300,7 +305,7 @@ where
                 .collect();
             for (index, answer) in answers.into_iter().enumerate() {
                 let mut value = answer?;
-                value["pose"] = json!(index);
+                insert(&mut value, "pose", json!(index));
                 println!("{value}");
             }
         }
@@ -326,7 +331,8 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
             "seconds": seconds,
         });
         if args.pairs {
-            value["pairs"] = json!(r.pairs.iter().map(|&(x, y)| [x, y]).collect::<Vec<_>>());
+            let pairs = r.pairs.iter().map(|&(x, y)| [x, y]).collect::<Vec<_>>();
+            insert(&mut value, "pairs", json!(pairs));
         }
         let mut text = format!(
             "colliding: {}, {} contact{}{} ({}) in {:.6} s",

@@ -91,17 +91,21 @@ impl Moments {
         );
         let w = norm2(n).sqrt(); // twice the area
         let s = [p[0] + q[0] + r[0], p[1] + q[1] + r[1], p[2] + q[2] + r[2]];
-        let e = |j: usize, k: usize| s[j] * s[k] + p[j] * p[k] + q[j] * q[k] + r[j] * r[k];
+        // Coordinate j of s, p, q, r; `e(j, k)` is Σ over the four of their j·k products.
+        let x = [s[0], p[0], q[0], r[0]];
+        let y = [s[1], p[1], q[1], r[1]];
+        let z = [s[2], p[2], q[2], r[2]];
+        let e = |j: [f64; 4], k: [f64; 4]| j[0] * k[0] + j[1] * k[1] + j[2] * k[2] + j[3] * k[3];
         self.weight += w;
         self.first[0] += w * s[0];
         self.first[1] += w * s[1];
         self.first[2] += w * s[2];
-        self.second[0] += w * e(0, 0);
-        self.second[1] += w * e(1, 1);
-        self.second[2] += w * e(2, 2);
-        self.second[3] += w * e(0, 1);
-        self.second[4] += w * e(0, 2);
-        self.second[5] += w * e(1, 2);
+        self.second[0] += w * e(x, x);
+        self.second[1] += w * e(y, y);
+        self.second[2] += w * e(z, z);
+        self.second[3] += w * e(x, y);
+        self.second[4] += w * e(x, z);
+        self.second[5] += w * e(y, z);
         self.kind = Kind::Area;
     }
 

@@ -65,8 +65,8 @@ pub(crate) fn classify(points: &[V3], magnitude: f64) -> Shape {
 pub(crate) struct Extremes {
     lo: V3,
     hi: V3,
-    /// Index of the first point attaining `lo[k]` (at `2k`) and `hi[k]` (at `2k + 1`).
-    ext: [usize; 6],
+    /// Index of the first point attaining `lo[k]` (at `[k][0]`) and `hi[k]` (at `[k][1]`).
+    ext: [[usize; 2]; 3],
 }
 
 impl Extremes {
@@ -75,23 +75,36 @@ impl Extremes {
         Extremes {
             lo: first,
             hi: first,
-            ext: [0; 6],
+            ext: [[0; 2]; 3],
         }
     }
 
     /// Takes point `i` into account; points must be added in index order.
     #[inline(always)]
     pub(crate) fn add(&mut self, i: usize, p: V3) {
-        for (k, &x) in p.iter().enumerate() {
-            if x < self.lo[k] {
-                self.lo[k] = x;
-                self.ext[2 * k] = i;
-            }
-            if x > self.hi[k] {
-                self.hi[k] = x;
-                self.ext[2 * k + 1] = i;
-            }
-        }
+        // One call per axis, spelled out: this runs once per point of every node.
+        let [lx, ly, lz] = &mut self.lo;
+        let [hx, hy, hz] = &mut self.hi;
+        let [ex, ey, ez] = &mut self.ext;
+        let [x, y, z] = p;
+        extend(x, lx, hx, ex, i);
+        extend(y, ly, hy, ey, i);
+        extend(z, lz, hz, ez, i);
+    }
+}
+
+/// One axis of [`Extremes::add`]: `x` of point `i` against the side values `lo`, `hi` and
+/// the points `at` that first attained them.
+#[inline(always)]
+fn extend(x: f64, lo: &mut f64, hi: &mut f64, at: &mut [usize; 2], i: usize) {
+    let [at_lo, at_hi] = at;
+    if x < *lo {
+        *lo = x;
+        *at_lo = i;
+    }
+    if x > *hi {
+        *hi = x;
+        *at_hi = i;
     }
 }
 
@@ -110,11 +123,12 @@ pub(crate) fn classify_with(points: &[V3], magnitude: f64, extremes: &Extremes) 
     // The farthest pair among the extremes spans the set well (it is within √3 of the
     // diameter), which keeps the line and plane below well conditioned.
     let (mut i0, mut i1, mut best) = (0usize, 0usize, -1.0);
-    for a in 0..6 {
-        for b in a + 1..6 {
-            let d = norm2(sub(at(ext[a]), at(ext[b])));
+    let ext = ext.as_flattened();
+    for (a, &ea) in ext.iter().enumerate() {
+        for &eb in ext.iter().skip(a + 1) {
+            let d = norm2(sub(at(ea), at(eb)));
             if d > best {
-                (i0, i1, best) = (ext[a], ext[b], d);
+                (i0, i1, best) = (ea, eb, d);
             }
         }
     }

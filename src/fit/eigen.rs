@@ -114,13 +114,18 @@ fn closed_form(a: &Sym3) -> Option<Eigenpairs> {
         ([m0, m1, lambda], [w0, w1, e])
     };
     // Rounding could in principle misorder values that are within a few ulps.
-    for i in 0..2 {
-        for j in 0..2 - i {
-            if values[j] < values[j + 1] {
-                values.swap(j, j + 1);
-                vectors.swap(j, j + 1);
-            }
-        }
+    // Bubble sort of three: compare-swap positions (0, 1), (1, 2), (0, 1).
+    if values[0] < values[1] {
+        values.swap(0, 1);
+        vectors.swap(0, 1);
+    }
+    if values[1] < values[2] {
+        values.swap(1, 2);
+        vectors.swap(1, 2);
+    }
+    if values[0] < values[1] {
+        values.swap(0, 1);
+        vectors.swap(0, 1);
     }
     values
         .iter()
@@ -137,10 +142,8 @@ fn iterative(a: &Sym3) -> Option<Eigenpairs> {
     let val = |i: usize| eig.eigenvalues.get(i).copied().unwrap_or(0.0);
     // Sort by decreasing eigenvalue; index order breaks exact ties deterministically.
     order.sort_by(|&i, &j| val(j).total_cmp(&val(i)).then(i.cmp(&j)));
-    let col = |i: usize| -> V3 {
-        let c = eig.eigenvectors.column(i);
-        [c[0], c[1], c[2]]
-    };
+    let columns: [V3; 3] = eig.eigenvectors.into();
+    let col = |i: usize| -> V3 { columns.get(i).copied().unwrap_or([0.0; 3]) };
     Some((order.map(val), order.map(col)))
 }
 

@@ -65,13 +65,13 @@ pub(crate) fn in_plane_axis(w: V3) -> V3 {
 /// Makes the sign of `c` deterministic: its largest-magnitude component (the first, on
 /// exact ties) is positive.
 fn fix_sign(c: V3) -> V3 {
-    let mut k = 0;
-    for i in 1..3 {
-        if c[i].abs() > c[k].abs() {
-            k = i;
+    let mut largest = c[0];
+    for x in [c[1], c[2]] {
+        if x.abs() > largest.abs() {
+            largest = x;
         }
     }
-    if c[k] < 0.0 {
+    if largest < 0.0 {
         scale(c, -1.0)
     } else {
         c

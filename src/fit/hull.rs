@@ -11,6 +11,7 @@ use super::dimension::{classify, Shape, DIMENSION_TOLERANCE};
 use super::polygon::convex_polygon;
 use super::quickhull::QuickHull;
 use super::vec3::{cross, dot, norm2, sub, V3};
+use crate::arr3;
 
 /// Relative plane tolerance of the hull, as a fraction of the point set's diameter
 /// (bounding-box diagonal).
@@ -67,7 +68,13 @@ impl ConvexHull {
         match self {
             ConvexHull::Point { .. } | ConvexHull::Segment { .. } => 0.0,
             ConvexHull::Polygon { vertices, .. } => match vertices.split_first() {
-                Some((&first, rest)) => rest.windows(2).map(|w| tri(first, w[0], w[1])).sum(),
+                Some((&first, rest)) => rest
+                    .windows(2)
+                    .map(|w| match *w {
+                        [a, b] => tri(first, a, b),
+                        _ => 0.0,
+                    })
+                    .sum(),
                 None => 0.0,
             },
             ConvexHull::Polyhedron { triangles } => {
@@ -115,20 +122,18 @@ impl std::error::Error for HullError {}
 /// is rare: no node of the shared test meshes but one in fandisk's tree hits it, and about
 /// 0.3 % of adversarial random sets do.
 pub fn convex_hull(points: &[[f64; 3]]) -> Result<ConvexHull, HullError> {
-    if points.is_empty() {
+    let Some(&first) = points.first() else {
         return Err(HullError::Empty);
-    }
+    };
     if points.len() >= u32::MAX as usize {
         return Err(HullError::TooManyPoints);
     }
     // Centre at the bounding-box centre so plane offsets carry little rounding.
-    let mut lo = points[0];
-    let mut hi = points[0];
+    let mut lo = first;
+    let mut hi = first;
     for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
+        lo = arr3::min(lo, *p);
+        hi = arr3::max(hi, *p);
     }
     let c = [
         0.5 * (lo[0] + hi[0]),

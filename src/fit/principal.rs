@@ -112,7 +112,9 @@ fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Frame, Source)> {
         let (&first, rest) = poly.split_first()?;
         let mut m = Moments::default();
         for w in rest.windows(2) {
-            m.add_triangle(at(first), at(w[0]), at(w[1]));
+            if let [a, b] = *w {
+                m.add_triangle(at(first), at(a), at(b));
+            }
         }
         let c = m.covariance()?;
         let (u, v, n) = plane_basis(shape);
@@ -192,7 +194,8 @@ fn largest_triangles(
         Source::HullFlat => {
             if let Some((&first, rest)) = s.hull.poly.split_first() {
                 for w in rest.windows(2) {
-                    if let (Some(p), Some(q), Some(r)) = (pt(first), pt(w[0]), pt(w[1])) {
+                    let &[a, b] = w else { continue };
+                    if let (Some(p), Some(q), Some(r)) = (pt(first), pt(a), pt(b)) {
                         best.offer(p, q, r);
                     }
                 }

@@ -301,7 +301,7 @@ impl QuickHull {
         // that edge k ends where edge k + 1 starts.
         self.new_faces.clear();
         for k in 0..self.horizon.len() {
-            let e = self.horizon[k];
+            let Some(&e) = self.horizon.get(k) else { break };
             let f = self.new_face(points, [e.a, e.b, apex], eps)?;
             self.new_faces.push(f);
         }
@@ -316,10 +316,18 @@ impl QuickHull {
         let h = self.new_faces.len();
         let mut prev_f = self.new_faces.last().copied().unwrap_or(NONE);
         for k in 0..h {
-            let (f, e) = (self.new_faces[k], self.horizon[k]);
             // Neighbours in the cone, without `%` (an integer division per edge).
             let next = if k + 1 < h { k + 1 } else { 0 };
-            let (next_f, next_b) = (self.new_faces[next], self.horizon[next].b);
+            // `new_faces` and `horizon` both have `h` entries, so these always succeed.
+            let (Some(&f), Some(&e), Some(&next_f), Some(next_e)) = (
+                self.new_faces.get(k),
+                self.horizon.get(k),
+                self.new_faces.get(next),
+                self.horizon.get(next),
+            ) else {
+                return Err(QuickHullError::Numerical);
+            };
+            let next_b = next_e.b;
             let (Some(across), Some(face), Some(following)) = (
                 self.faces.get(e.across as usize),
                 self.faces.get(f as usize),
@@ -327,11 +335,9 @@ impl QuickHull {
             ) else {
                 return Err(QuickHullError::Numerical);
             };
-            let j = find_edge(&across.v, e.b, e.a).ok_or(QuickHullError::Numerical)?;
-            let (Some(&w), Some(&c)) = (
-                points.get(across.v[(j + 2) % 3] as usize),
-                points.get(next_b as usize),
-            ) else {
+            let (j, far) = find_edge(&across.v, e.b, e.a).ok_or(QuickHullError::Numerical)?;
+            let (Some(&w), Some(&c)) = (points.get(far as usize), points.get(next_b as usize))
+            else {
                 return Err(QuickHullError::Numerical);
             };
             if broken_edge(face, across.normal, w, limit, flat)
@@ -339,8 +345,12 @@ impl QuickHull {
             {
                 return Err(QuickHullError::Numerical);
             }
-            if let Some(across) = self.faces.get_mut(e.across as usize) {
-                across.adj[j] = f;
+            if let Some(adj) = self
+                .faces
+                .get_mut(e.across as usize)
+                .and_then(|across| across.adj.get_mut(j))
+            {
+                *adj = f;
             }
             if let Some(face) = self.faces.get_mut(f as usize) {
                 face.adj = [e.across, next_f, prev_f];
@@ -350,14 +360,18 @@ impl QuickHull {
 
         // Hand the outside points of the doomed faces to the new ones.
         for vi in 0..self.visible.len() {
-            let g = self.visible[vi];
+            let Some(&g) = self.visible.get(vi) else {
+                break;
+            };
             let mut p = self.faces.get(g as usize).map_or(NONE, |x| x.head);
             while p != NONE {
                 let following = self.next.get(p as usize).copied().unwrap_or(NONE);
                 if p != apex {
                     if let Some(&q) = points.get(p as usize) {
                         for k in 0..h {
-                            let f = self.new_faces[k];
+                            let Some(&f) = self.new_faces.get(k) else {
+                                break;
+                            };
                             if let Some(d) = self.faces.get(f as usize).and_then(|x| x.outside(q)) {
                                 self.push_outside(f, p, d);
                                 break;
@@ -368,16 +382,14 @@ impl QuickHull {
                 p = following;
             }
         }
-        for vi in 0..self.visible.len() {
-            let g = self.visible[vi];
+        for &g in &self.visible {
             if let Some(face) = self.faces.get_mut(g as usize) {
                 face.alive = false;
                 face.head = NONE;
                 self.free.push(g);
             }
         }
-        for k in 0..h {
-            let f = self.new_faces[k];
+        for &f in &self.new_faces {
             if self.faces.get(f as usize).is_some_and(|x| x.head != NONE) {
                 self.pending.push(f);
             }
@@ -406,8 +418,7 @@ impl QuickHull {
                 .get(g as usize)
                 .map(|x| (x.v, x.adj))
                 .ok_or(QuickHullError::Numerical)?;
-            for i in 0..3 {
-                let h = adj[i];
+            for (a, b, h) in edges(v, adj) {
                 let hf = self
                     .faces
                     .get_mut(h as usize)
@@ -429,11 +440,7 @@ impl QuickHull {
                     }
                 }
                 if !hf.visible {
-                    self.horizon.push(Edge {
-                        a: v[i],
-                        b: v[(i + 1) % 3],
-                        across: h,
-                    });
+                    self.horizon.push(Edge { a, b, across: h });
                 }
             }
         }
@@ -498,7 +505,9 @@ impl QuickHull {
     fn absorb_coplanar(&mut self, apex: V3, it: u32, margin: f64) -> bool {
         let mut grown = false;
         for k in 0..self.horizon.len() {
-            let h = self.horizon[k].across;
+            let Some(h) = self.horizon.get(k).map(|e| e.across) else {
+                return false;
+            };
             let Some(face) = self.faces.get_mut(h as usize) else {
                 return false;
             };
@@ -522,7 +531,9 @@ impl QuickHull {
     fn absorb_folds(&mut self, points: &[V3], apex: V3, it: u32) -> bool {
         let mut grown = false;
         for k in 0..self.horizon.len() {
-            let e = self.horizon[k];
+            let Some(&e) = self.horizon.get(k) else {
+                return false;
+            };
             let (Some(&a), Some(&b)) = (points.get(e.a as usize), points.get(e.b as usize)) else {
                 return false;
             };
@@ -549,22 +560,17 @@ impl QuickHull {
     /// Recomputes the (unordered) horizon of the visible faces; false on broken adjacency.
     fn rebuild_horizon(&mut self, it: u32) -> bool {
         self.horizon.clear();
-        for vi in 0..self.visible.len() {
-            let g = self.visible[vi];
+        for &g in &self.visible {
             let Some(&Face { v, adj, .. }) = self.faces.get(g as usize) else {
                 return false;
             };
-            for i in 0..3 {
+            for (a, b, across) in edges(v, adj) {
                 let visible = self
                     .faces
-                    .get(adj[i] as usize)
+                    .get(across as usize)
                     .is_some_and(|x| x.mark == it && x.visible);
                 if !visible {
-                    self.horizon.push(Edge {
-                        a: v[i],
-                        b: v[(i + 1) % 3],
-                        across: adj[i],
-                    });
+                    self.horizon.push(Edge { a, b, across });
                 }
             }
         }
@@ -612,12 +618,18 @@ fn broken_edge(face: &Face, normal: V3, far: V3, limit: f64, flat: f64) -> bool 
 /// area.
 #[allow(clippy::type_complexity)]
 fn seed_faces(points: &[V3], s: [usize; 4]) -> Result<[([u32; 3], [u32; 3]); 4], QuickHullError> {
-    let pt = |i: usize| points.get(i).copied().ok_or(QuickHullError::Input);
+    // Point `s[k]`, and its index as a `u32`.
+    let at = |k: usize| s.get(k).copied().ok_or(QuickHullError::Input);
+    let pt = |k: usize| {
+        let i = at(k)?;
+        points.get(i).copied().ok_or(QuickHullError::Input)
+    };
+    let id = |k: usize| u32::try_from(at(k)?).map_err(|_| QuickHullError::Input);
     // Each face with the vertex it must face away from, as positions in `s`.
     let combos = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)];
     let mut faces = [([0; 3], [0; 3]); 4];
     for (face, (a, mut b, mut c, o)) in faces.iter_mut().zip(combos) {
-        let (pa, pb, pc, po) = (pt(s[a])?, pt(s[b])?, pt(s[c])?, pt(s[o])?);
+        let (pa, pb, pc, po) = (pt(a)?, pt(b)?, pt(c)?, pt(o)?);
         let normal = cross(sub(pb, pa), sub(pc, pa));
         if dot(normal, sub(po, pa)) > 0.0 {
             std::mem::swap(&mut b, &mut c);
@@ -627,23 +639,34 @@ fn seed_faces(points: &[V3], s: [usize; 4]) -> Result<[([u32; 3], [u32; 3]); 4],
             return Err(QuickHullError::Numerical);
         }
         *face = (
-            [s[a] as u32, s[b] as u32, s[c] as u32],
+            [id(a)?, id(b)?, id(c)?],
             [3 - c as u32, 3 - a as u32, 3 - b as u32],
         );
     }
     Ok(faces)
 }
 
-/// Position `j` with `v[j] == a` and `v[(j + 1) % 3] == b`, if the triangle has that edge.
+/// Position `j` with `v[j] == a` and `v[(j + 1) % 3] == b`, if the triangle has that edge,
+/// and the third vertex `v[(j + 2) % 3]`.
 #[inline]
-fn find_edge(v: &[u32; 3], a: u32, b: u32) -> Option<usize> {
+fn find_edge(v: &[u32; 3], a: u32, b: u32) -> Option<(usize, u32)> {
     if v[0] == a && v[1] == b {
-        Some(0)
+        Some((0, v[2]))
     } else if v[1] == a && v[2] == b {
-        Some(1)
+        Some((1, v[0]))
     } else if v[2] == a && v[0] == b {
-        Some(2)
+        Some((2, v[1]))
     } else {
         None
     }
+}
+
+/// The edges `v[i] → v[(i + 1) % 3]` of a face with the face across each (`adj[i]`).
+#[inline(always)]
+fn edges(v: [u32; 3], adj: [u32; 3]) -> [(u32, u32, u32); 3] {
+    [
+        (v[0], v[1], adj[0]),
+        (v[1], v[2], adj[1]),
+        (v[2], v[0], adj[2]),
+    ]
 }

@@ -7,6 +7,7 @@
 use super::dimension::Extremes;
 use super::hull::HullScratch;
 use super::vec3::V3;
+use crate::arr3;
 
 /// Buffers reused across fits on one thread.
 #[derive(Debug, Default)]
@@ -82,17 +83,14 @@ impl Scratch {
         };
         let (mut lo, mut hi) = (first, first);
         for p in &self.pts {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
+            lo = arr3::min(lo, *p);
+            hi = arr3::max(hi, *p);
         }
-        let mut c = [0.0; 3];
-        let mut magnitude = 0.0_f64;
-        for k in 0..3 {
-            c[k] = 0.5 * (lo[k] + hi[k]);
-            magnitude = magnitude.max(lo[k].abs()).max(hi[k].abs());
-        }
+        let sides = arr3::zip(lo, hi);
+        let c = arr3::map(sides, |(lo, hi)| 0.5 * (lo + hi));
+        let magnitude = sides
+            .iter()
+            .fold(0.0_f64, |m, (lo, hi)| m.max(lo.abs()).max(hi.abs()));
         self.magnitude = magnitude;
         let centred = |p: V3| [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
         let mut extremes = Extremes::new(centred(first));

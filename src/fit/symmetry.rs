@@ -40,21 +40,28 @@ impl LargestTriangles {
         if !(s > 0.0 && s.is_finite()) {
             return;
         }
-        // Insertion into a tiny sorted array.
-        let mut k = self.len.min(CANDIDATES);
-        while k > 0 && self.size[k - 1] < s {
-            k -= 1;
-        }
+        // Insertion into a tiny sorted array: `s` goes before the first smaller size (sizes
+        // are descending, so that is where a backward scan would stop).
+        let len = self.len.min(CANDIDATES);
+        let k = self
+            .size
+            .iter()
+            .take(len)
+            .position(|&x| x < s)
+            .unwrap_or(len);
         if k >= CANDIDATES {
             return;
         }
+        // Shift `k..end` one place up (the last entry drops off a full array).
         let end = self.len.min(CANDIDATES - 1);
-        for i in (k..end).rev() {
-            self.size[i + 1] = self.size[i];
-            self.tris[i + 1] = self.tris[i];
+        if let (Some(size), Some(tris)) = (self.size.get_mut(k..=end), self.tris.get_mut(k..=end)) {
+            size.rotate_right(1);
+            tris.rotate_right(1);
         }
-        self.size[k] = s;
-        self.tris[k] = [p, q, r];
+        if let (Some(size), Some(tri)) = (self.size.get_mut(k), self.tris.get_mut(k)) {
+            *size = s;
+            *tri = [p, q, r];
+        }
         self.len = (self.len + 1).min(CANDIDATES);
     }
 

@@ -14,6 +14,7 @@ use super::eigen::axes2;
 use super::frame::{finish, Frame};
 use super::symmetry::{refine, LargestTriangles};
 use super::vec3::{cross, dot, norm2, normalize, sub, V3};
+use crate::arr3;
 
 /// The principal-axes frame of triangle `(p, q, r)`, by the same rules as the general fit.
 pub(crate) fn triangle_frame(p: V3, q: V3, r: V3) -> Matrix3<f64> {
@@ -21,11 +22,9 @@ pub(crate) fn triangle_frame(p: V3, q: V3, r: V3) -> Matrix3<f64> {
     let mut hi = p;
     let mut magnitude = 0.0_f64;
     for x in [p, q, r] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(x[k]);
-            hi[k] = hi[k].max(x[k]);
-            magnitude = magnitude.max(x[k].abs());
-        }
+        lo = arr3::min(lo, x);
+        hi = arr3::max(hi, x);
+        magnitude = x.iter().fold(magnitude, |m, c| m.max(c.abs()));
     }
     let d2 = norm2(sub(hi, lo));
     let point = POINT_TOLERANCE * magnitude;

@@ -44,12 +44,16 @@ impl AlignedBytes {
 
     /// The bytes.
     pub fn as_bytes(&self) -> &[u8] {
-        &self.blocks.as_bytes()[..self.len]
+        // `len` never exceeds the blocks' bytes (both are set together above).
+        self.blocks.as_bytes().get(..self.len).unwrap_or_default()
     }
 
     /// The bytes, mutable.
     pub fn as_mut_bytes(&mut self) -> &mut [u8] {
-        &mut self.blocks.as_mut_bytes()[..self.len]
+        self.blocks
+            .as_mut_bytes()
+            .get_mut(..self.len)
+            .unwrap_or_default()
     }
 }
 

@@ -165,8 +165,7 @@ impl SectionKind {
 
 /// Rounds `n` up to the next multiple of [`SECTION_ALIGN`], or `None` on overflow.
 pub fn align_up(n: u64) -> Option<u64> {
-    n.checked_add(SECTION_ALIGN - 1)
-        .map(|m| m / SECTION_ALIGN * SECTION_ALIGN)
+    n.checked_next_multiple_of(SECTION_ALIGN)
 }
 
 /// CRC-32 of the header (without its CRC field) followed by the directory.

@@ -6,6 +6,13 @@
 //! checks live in [`ObbtFile::verify`]. Queries on an unverified file use checked access, so
 //! a corrupt file gives an error or a wrong-but-safe answer, never undefined behaviour.
 
+// Everything here reads untrusted bytes: on top of the crate's no-panic lints, integer
+// arithmetic must be checked or saturating and narrowing casts must be `try_from`.
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::cast_possible_truncation)
+)]
+
 mod aligned;
 mod error;
 pub mod layout;

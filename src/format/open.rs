@@ -131,8 +131,8 @@ pub trait TreeVisitor {
     fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output;
 }
 
-/// The stride of one node record of a given volume and precision.
-pub(crate) fn node_size(bv: BvKind, precision: Precision) -> usize {
+/// The stride of one node record of a given volume and precision (at most 128 bytes).
+fn node_size(bv: BvKind, precision: Precision) -> usize {
     match (bv, precision) {
         (BvKind::Obb, Precision::F32) => Node::<Obb<f32>>::SIZE,
         (BvKind::Obb, Precision::F64) => Node::<Obb<f64>>::SIZE,
@@ -142,6 +142,10 @@ pub(crate) fn node_size(bv: BvKind, precision: Precision) -> usize {
         (BvKind::Sphere, Precision::F64) => Node::<Sphere<f64>>::SIZE,
     }
 }
+
+/// [`SECTION_ALIGN`] as a `usize`, for checking a buffer's address.
+const SECTION_ALIGN_BYTES: usize = 64;
+const _: () = assert!(SECTION_ALIGN_BYTES as u64 == SECTION_ALIGN);
 
 fn field(field: &'static str, offset: usize, problem: impl Into<String>) -> FormatError {
     FormatError::HeaderField {
@@ -259,27 +263,35 @@ impl ObbtFile {
             });
         }
         let bytes = self.bytes();
-        let section = |k: usize| {
-            let kind = SectionKind::ALL[k];
-            let range = self.required[k].clone();
-            let problem = |p: &str| FormatError::Section {
-                index: k,
-                kind: kind.name().into(),
-                problem: p.into(),
-            };
-            bytes.get(range).ok_or_else(|| problem("out of bounds"))
-        };
-        let cast_err = |k: usize| FormatError::Section {
+        let problem = |k: usize, kind: SectionKind, p: &str| FormatError::Section {
             index: k,
-            kind: SectionKind::ALL[k].name().into(),
-            problem: "cannot be viewed as records (misaligned or bad length)".into(),
+            kind: kind.name().into(),
+            problem: p.into(),
+        };
+        let [vertices, faces, source_ids, nodes] = SectionKind::ALL;
+        let section = |k: usize, kind: SectionKind| {
+            self.required
+                .get(k)
+                .and_then(|range| bytes.get(range.clone()))
+                .ok_or_else(|| problem(k, kind, "out of bounds"))
+        };
+        let cast_err = |k, kind| {
+            problem(
+                k,
+                kind,
+                "cannot be viewed as records (misaligned or bad length)",
+            )
         };
         Ok(TreeView {
             encoding: self.encoding,
-            vertices: <[[B::Real; 3]]>::ref_from_bytes(section(0)?).map_err(|_| cast_err(0))?,
-            faces: <[[u32; 3]]>::ref_from_bytes(section(1)?).map_err(|_| cast_err(1))?,
-            source_ids: <[u32]>::ref_from_bytes(section(2)?).map_err(|_| cast_err(2))?,
-            nodes: <[Node<B>]>::ref_from_bytes(section(3)?).map_err(|_| cast_err(3))?,
+            vertices: <[[B::Real; 3]]>::ref_from_bytes(section(0, vertices)?)
+                .map_err(|_| cast_err(0, vertices))?,
+            faces: <[[u32; 3]]>::ref_from_bytes(section(1, faces)?)
+                .map_err(|_| cast_err(1, faces))?,
+            source_ids: <[u32]>::ref_from_bytes(section(2, source_ids)?)
+                .map_err(|_| cast_err(2, source_ids))?,
+            nodes: <[Node<B>]>::ref_from_bytes(section(3, nodes)?)
+                .map_err(|_| cast_err(3, nodes))?,
         })
     }
 
@@ -300,7 +312,7 @@ impl ObbtFile {
             return Err(FormatError::BigEndianHost);
         }
         let bytes = backing.bytes();
-        if bytes.as_ptr() as usize % SECTION_ALIGN as usize != 0 {
+        if bytes.as_ptr().addr() % SECTION_ALIGN_BYTES != 0 {
             return Err(FormatError::Misaligned);
         }
         let checked = check_header(bytes)?;
@@ -351,7 +363,10 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             format!("{count} is outside 1..={MAX_SECTIONS}"),
         ));
     }
-    let header_bytes = HEADER_SIZE + ENTRY_SIZE * usize::from(count);
+    // At most 128 + 40 * 16 bytes: `count` was just checked.
+    let header_bytes = ENTRY_SIZE
+        .saturating_mul(usize::from(count))
+        .saturating_add(HEADER_SIZE);
     if header.header_bytes.get() as usize != header_bytes {
         return Err(field(
             "header_bytes",
@@ -416,13 +431,13 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
         match kind {
             SectionKind::Vertices => (
                 u64::from(header.vertices.get()),
-                3 * u32::from(precision.tag()),
+                u32::from(precision.tag()).saturating_mul(3),
             ),
             SectionKind::Faces => (u64::from(header.triangles.get()), 12),
             SectionKind::SourceIds => (u64::from(header.triangles.get()), 4),
             SectionKind::Nodes => (
                 u64::from(header.nodes.get()),
-                node_size(bv, precision) as u32,
+                u32::try_from(node_size(bv, precision)).unwrap_or(u32::MAX),
             ),
         }
     };
@@ -474,10 +489,11 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             }
             None => {}
             Some(kind) => {
-                let slot = &mut required[SectionKind::ALL
-                    .iter()
-                    .position(|&k| k == kind)
-                    .unwrap_or(0)];
+                let slot = required
+                    .iter_mut()
+                    .zip(SectionKind::ALL)
+                    .find_map(|(slot, k)| (k == kind).then_some(slot))
+                    .ok_or_else(|| bad("unknown section kind".into()))?;
                 if slot.is_some() {
                     return Err(bad("duplicate section".into()));
                 }
@@ -488,7 +504,12 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
                         info.count, info.stride
                     )));
                 }
-                *slot = Some(info.offset as usize..end as usize);
+                // Both are at most the buffer's length, so they fit a `usize`.
+                let (Ok(start), Ok(end)) = (usize::try_from(info.offset), usize::try_from(end))
+                else {
+                    return Err(bad("out of the address space".into()));
+                };
+                *slot = Some(start..end);
             }
         }
         sections.push(info);
@@ -496,7 +517,8 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
     let mut spans: Vec<(u64, u64, usize)> = sections
         .iter()
         .enumerate()
-        .map(|(i, s)| (s.offset, s.offset + s.length, i))
+        // Offset + length was checked not to overflow above.
+        .map(|(i, s)| (s.offset, s.offset.saturating_add(s.length), i))
         .collect();
     spans.sort_unstable();
     for pair in spans.windows(2) {
@@ -504,19 +526,21 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             if start_b < end_a {
                 return Err(FormatError::Section {
                     index: *b,
-                    kind: sections[*b].name(),
+                    kind: sections.get(*b).map(SectionInfo::name).unwrap_or_default(),
                     problem: format!("overlaps section entry {a}"),
                 });
             }
         }
     }
     let mut ranges: [Range<usize>; 4] = Default::default();
-    for (k, slot) in required.into_iter().enumerate() {
-        ranges[k] = slot.ok_or(FormatError::MissingSection(SectionKind::ALL[k].name()))?;
+    for ((range, slot), kind) in ranges.iter_mut().zip(required).zip(SectionKind::ALL) {
+        *range = slot.ok_or(FormatError::MissingSection(kind.name()))?;
     }
-    if encoding == Encoding::Binary
-        && u64::from(header.nodes.get()) != 2 * u64::from(header.triangles.get()) - 1
-    {
+    // `triangles` is at least 1 (checked above), and doubling a `u32` fits a `u64`.
+    let binary_nodes = u64::from(header.triangles.get())
+        .saturating_mul(2)
+        .saturating_sub(1);
+    if encoding == Encoding::Binary && u64::from(header.nodes.get()) != binary_nodes {
         return Err(field(
             "nodes",
             40,

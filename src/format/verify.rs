@@ -11,12 +11,19 @@ use crate::mesh::triangle_is_degenerate;
 use crate::real::point_to_f64;
 use crate::tree::{NodeRef, TreeView};
 
+/// The byte range `offset .. offset + length` as indices into a buffer, if it fits one.
+fn byte_range(offset: u64, length: u64) -> Option<std::ops::Range<usize>> {
+    let start = usize::try_from(offset).ok()?;
+    let end = usize::try_from(offset.checked_add(length)?).ok()?;
+    Some(start..end)
+}
+
 pub(crate) fn verify(file: &ObbtFile) -> Result<(), VerifyError> {
     let bytes = file.bytes();
     check_padding(file, bytes)?;
     for (i, s) in file.sections().iter().enumerate() {
-        let data = bytes
-            .get(s.offset as usize..(s.offset + s.length) as usize)
+        let data = byte_range(s.offset, s.length)
+            .and_then(|range| bytes.get(range))
             .ok_or_else(|| VerifyError::new(format!("section {}", s.name()), "out of bounds"))?;
         let crc = crc32fast::hash(data);
         if crc != s.crc32 {
@@ -39,7 +46,8 @@ fn check_padding(file: &ObbtFile, bytes: &[u8]) -> Result<(), VerifyError> {
     let mut spans: Vec<(u64, u64)> = file
         .sections()
         .iter()
-        .map(|s| (s.offset, s.offset + s.length))
+        // `open` checked that every section lies inside the file, so this cannot saturate.
+        .map(|s| (s.offset, s.offset.saturating_add(s.length)))
         .collect();
     spans.sort_unstable();
     let mut cursor = u64::from(file.header().header_bytes.get());
@@ -47,17 +55,20 @@ fn check_padding(file: &ObbtFile, bytes: &[u8]) -> Result<(), VerifyError> {
         .into_iter()
         .chain([(bytes.len() as u64, bytes.len() as u64)])
     {
-        let gap = bytes.get(cursor as usize..start as usize).unwrap_or(&[]);
+        let gap = byte_range(cursor, start.saturating_sub(cursor))
+            .and_then(|range| bytes.get(range))
+            .unwrap_or(&[]);
         if let Some(k) = gap.iter().position(|&b| b != 0) {
             return Err(VerifyError::new(
                 "padding",
-                format!("byte {} is not zero", cursor as usize + k),
+                format!("byte {} is not zero", cursor.saturating_add(k as u64)),
             ));
         }
-        if start.saturating_sub(cursor) >= SECTION_ALIGN {
+        let padding = start.saturating_sub(cursor);
+        if padding >= SECTION_ALIGN {
             return Err(VerifyError::new(
                 "padding",
-                format!("{} bytes of padding at {cursor}", start - cursor),
+                format!("{padding} bytes of padding at {cursor}"),
             ));
         }
         cursor = cursor.max(end);
@@ -119,14 +130,16 @@ impl TreeVisitor for Contents<'_> {
             tree.nodes().len(),
         )
         .ok_or_else(|| VerifyError::new("section nodes", "not a tree"))?;
+        // Every index was checked against `positions` above.
         let degenerate = tree
             .faces()
             .iter()
-            .filter(|f| {
-                let c = |k: usize| positions[f[k] as usize];
-                triangle_is_degenerate(c(0), c(1), c(2))
+            .filter(|f| match f.map(|v| positions.get(v as usize)) {
+                [Some(&p), Some(&q), Some(&r)] => triangle_is_degenerate(p, q, r),
+                _ => false,
             })
-            .count() as u32;
+            .count();
+        let degenerate = u32::try_from(degenerate).unwrap_or(u32::MAX);
         let (lo, hi) = crate::build::bounds_of(&positions);
         let claims = [
             ("leaves", info.leaves, stats.leaves),
@@ -172,9 +185,13 @@ fn check_nodes<B: BoundingVolume>(
     let mut parent = vec![u32::MAX; nodes.len()];
     let mut face_owner = vec![u32::MAX; tree.faces().len()];
     for (i, node) in nodes.iter().enumerate() {
-        if i > 0 && parent[i] == u32::MAX {
+        // Parents come first, so a node's entry is final when it is reached.
+        if i > 0 && parent.get(i).is_none_or(|&p| p == u32::MAX) {
             return Err(bad(i, "no parent references it".into()));
         }
+        // Fewer than `u32::MAX` nodes (the header counts them in a `u32`), so the index
+        // never collides with the `u32::MAX` marker.
+        let index = u32::try_from(i).map_err(|_| bad(i, "index exceeds u32".into()))?;
         node.bv.validate().map_err(|d| bad(i, d.to_string()))?;
         let r = tree.node_ref(node);
         let range = r.range();
@@ -192,11 +209,15 @@ fn check_nodes<B: BoundingVolume>(
                     ));
                 }
                 for c in range {
-                    let slot = &mut parent[c as usize];
+                    // In bounds: the range was checked against `nodes.len()` just above.
+                    let slot = usize::try_from(c).ok().and_then(|c| parent.get_mut(c));
+                    let Some(slot) = slot else {
+                        return Err(bad(i, format!("child {c} is out of bounds")));
+                    };
                     if *slot != u32::MAX {
                         return Err(bad(i, format!("child {c} already has parent {}", *slot)));
                     }
-                    *slot = i as u32;
+                    *slot = index;
                 }
             }
             NodeRef::Leaf { count, .. } => {
@@ -216,11 +237,15 @@ fn check_nodes<B: BoundingVolume>(
                     ));
                 }
                 for f in range {
-                    let owner = &mut face_owner[f as usize];
+                    // In bounds: the range was checked against the face count just above.
+                    let owner = usize::try_from(f).ok().and_then(|f| face_owner.get_mut(f));
+                    let Some(owner) = owner else {
+                        return Err(bad(i, format!("face {f} is out of bounds")));
+                    };
                     if *owner != u32::MAX {
                         return Err(bad(i, format!("face {f} is also in leaf {}", *owner)));
                     }
-                    *owner = i as u32;
+                    *owner = index;
                 }
             }
         }
@@ -238,27 +263,34 @@ fn check_nodes<B: BoundingVolume>(
         .flatten()
         .fold(1.0f64, |m, c| m.max(c.abs()));
     let tolerance = 1e-12 * scale;
-    for (f, &leaf) in face_owner.iter().enumerate() {
-        let corners = tree.faces()[f].map(|v| positions[v as usize]);
+    // Every index below was checked above (vertex indices in `visit`, face ranges and
+    // parents here); a failed lookup is reported rather than trusted.
+    let unchecked = |what: &str| VerifyError::new("section nodes", format!("{what} out of bounds"));
+    for (f, (&leaf, face)) in face_owner.iter().zip(tree.faces()).enumerate() {
+        let [Some(&p), Some(&q), Some(&r)] = face.map(|v| positions.get(v as usize)) else {
+            return Err(unchecked("vertex index"));
+        };
+        let corners = [p, q, r];
         let mut at = leaf;
         loop {
-            let node = &nodes[at as usize];
-            if let Some(k) = corners
+            let node = nodes
+                .get(at as usize)
+                .ok_or_else(|| unchecked("leaf or parent"))?;
+            if let Some((k, (_, vertex))) = corners
                 .iter()
-                .position(|&p| !node.bv.contains(p, tolerance))
+                .zip(face)
+                .enumerate()
+                .find(|(_, (&p, _))| !node.bv.contains(p, tolerance))
             {
                 return Err(bad(
                     at as usize,
-                    format!(
-                        "volume does not contain corner {k} of face {f} (vertex {})",
-                        tree.faces()[f][k]
-                    ),
+                    format!("volume does not contain corner {k} of face {f} (vertex {vertex})"),
                 ));
             }
             if at == 0 {
                 break;
             }
-            at = parent[at as usize];
+            at = *parent.get(at as usize).ok_or_else(|| unchecked("parent"))?;
         }
     }
     Ok(())

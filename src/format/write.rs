@@ -6,15 +6,26 @@ use super::layout::{
     HEADER_SIZE, SIGNATURE, VERSION_MAJOR, VERSION_MINOR,
 };
 use super::open::ObbtFile;
-use crate::build::{BuildOptions, BuiltTree};
+use crate::build::{BuildError, BuildOptions, BuiltTree};
 use crate::bv::{BoundingVolume, Node};
 use crate::real::{Precision, Real};
-use crate::tree::EncodeError;
 use rayon::prelude::*;
 use std::io::Write;
 use std::ops::Range;
 use std::path::Path;
 use zerocopy::IntoBytes;
+
+/// Number of sections the writer lays out: the four required ones.
+const SECTIONS: usize = SectionKind::ALL.len();
+/// Bytes of header plus directory.
+const HEADER_BYTES: usize = HEADER_SIZE + ENTRY_SIZE * SECTIONS;
+
+/// The error for a size this platform cannot address, or a count the format cannot hold.
+fn too_large(what: &str) -> BuildError {
+    BuildError::Image(format!(
+        "{what} exceeds this platform's or the format's limits"
+    ))
+}
 
 /// Serializes a finished tree. The layout is fully determined by the tree and options, so
 /// equal inputs give byte-identical images.
@@ -22,41 +33,55 @@ use zerocopy::IntoBytes;
 /// Every section is encoded straight into its place in the (zero-initialised) image, so the
 /// image is the only large buffer the writer touches.
 ///
-/// Fails if a node reference does not fit the tree's encoding.
+/// Fails if a node reference does not fit the tree's encoding, or the image does not fit
+/// this platform's address space.
 pub(crate) fn serialize<B: BoundingVolume>(
     tree: &BuiltTree<B>,
     options: &BuildOptions,
-) -> Result<ObbtFile, EncodeError> {
+) -> Result<ObbtFile, BuildError> {
     let scalar = std::mem::size_of::<B::Real>();
     // (kind, count, stride) in file order; the byte length of each is count * stride.
     let sections = [
         (
             SectionKind::Vertices,
             tree.vertices.len() as u64,
-            3 * scalar as u32,
+            u32::from(<B::Real as Real>::PRECISION.tag()).saturating_mul(3),
         ),
         (SectionKind::Faces, tree.faces.len() as u64, 12),
         (SectionKind::SourceIds, tree.source_ids.len() as u64, 4),
         (
             SectionKind::Nodes,
             tree.node_count as u64,
-            Node::<B>::SIZE as u32,
+            u32::try_from(Node::<B>::SIZE).map_err(|_| too_large("the node size"))?,
         ),
     ];
 
-    let header_bytes = HEADER_SIZE + ENTRY_SIZE * sections.len();
-    let mut offset = align64(header_bytes as u64);
-    let mut ranges = Vec::with_capacity(sections.len());
-    for &(_, count, stride) in &sections {
-        let length = count * u64::from(stride);
-        ranges.push(offset as usize..(offset + length) as usize);
-        offset = align64(offset + length);
+    // Sizes come from the mesh, so every step is checked: on a 32-bit host a large mesh
+    // can exceed the address space.
+    let mut offset = align_up(HEADER_BYTES as u64).ok_or_else(|| too_large("the header"))?;
+    let mut ranges: [Range<usize>; SECTIONS] = Default::default();
+    for (range, &(kind, count, stride)) in ranges.iter_mut().zip(&sections) {
+        let end = count
+            .checked_mul(u64::from(stride))
+            .and_then(|length| offset.checked_add(length));
+        let (Ok(start), Some(Ok(end))) = (usize::try_from(offset), end.map(usize::try_from)) else {
+            return Err(too_large(kind.name()));
+        };
+        *range = start..end;
+        offset = align_up(end as u64).ok_or_else(|| too_large(kind.name()))?;
     }
     let total = offset;
-    let mut image = AlignedBytes::zeroed_in_parallel(total as usize);
+    let len = usize::try_from(total)
+        .ok()
+        .filter(|&n| isize::try_from(n).is_ok())
+        .ok_or_else(|| too_large("the image"))?;
+    let mut image = AlignedBytes::zeroed_in_parallel(len);
     let bytes = image.as_mut_bytes();
 
-    let [vertices, faces, ids, nodes] = sections_mut(bytes, &ranges);
+    let layout_error = || BuildError::Image("sections out of bounds".into());
+    let [vertices, faces, ids, nodes] = bytes
+        .get_disjoint_mut(ranges.clone())
+        .map_err(|_| layout_error())?;
     let chunks = vertices.chunks_exact_mut(scalar);
     for (out, v) in chunks.zip(tree.vertices.iter().flatten()) {
         put_real(*v, out);
@@ -67,41 +92,50 @@ pub(crate) fn serialize<B: BoundingVolume>(
     for (out, i) in ids.chunks_exact_mut(4).zip(&tree.source_ids) {
         out.copy_from_slice(&i.to_le_bytes());
     }
-    let nodes_crc = write_nodes(tree, nodes)?;
+    let crcs = [
+        crc32fast::hash(vertices),
+        crc32fast::hash(faces),
+        crc32fast::hash(ids),
+        write_nodes(tree, nodes)?,
+    ];
 
     let entries: Vec<SectionEntry> = sections
         .iter()
         .zip(&ranges)
-        .map(|(&(kind, count, stride), range)| SectionEntry {
+        .zip(crcs)
+        .map(|((&(kind, count, stride), range), crc)| SectionEntry {
             kind: kind.tag().into(),
             flags: FLAG_REQUIRED.into(),
             offset: (range.start as u64).into(),
             length: (range.len() as u64).into(),
             count: count.into(),
             stride: stride.into(),
-            crc32: match kind {
-                SectionKind::Nodes => nodes_crc,
-                _ => crc32fast::hash(&bytes[range.clone()]),
-            }
-            .into(),
+            crc32: crc.into(),
         })
         .collect();
     let s = &tree.stats;
+    // The builder checked these counts against the format's limits; a failure here is a
+    // count the format cannot hold.
+    let count32 = |n: usize, what: &str| u32::try_from(n).map_err(|_| too_large(what));
     let mut header = Header {
         signature: SIGNATURE,
         version_major: VERSION_MAJOR.into(),
         version_minor: VERSION_MINOR.into(),
-        header_bytes: (header_bytes as u32).into(),
+        header_bytes: count32(HEADER_BYTES, "the header")?.into(),
         file_bytes: total.into(),
         bv_kind: options.bv.tag(),
         precision: options.precision.tag(),
         encoding: tree.encoding.tag(),
         fit_method: options.fit.tag(),
-        leaf_size: (options.leaf_size as u16).into(),
-        section_count: (sections.len() as u16).into(),
-        triangles: (tree.faces.len() as u32).into(),
-        vertices: (tree.vertices.len() as u32).into(),
-        nodes: (tree.node_count as u32).into(),
+        leaf_size: u16::try_from(options.leaf_size)
+            .map_err(|_| BuildError::LeafSize(options.leaf_size))?
+            .into(),
+        section_count: u16::try_from(SECTIONS)
+            .map_err(|_| too_large("the section count"))?
+            .into(),
+        triangles: count32(tree.faces.len(), "the triangle count")?.into(),
+        vertices: count32(tree.vertices.len(), "the vertex count")?.into(),
+        nodes: count32(tree.node_count, "the node count")?.into(),
         leaves: s.leaves.into(),
         depth: s.depth.into(),
         degenerate_triangles: s.degenerate_triangles.into(),
@@ -117,9 +151,15 @@ pub(crate) fn serialize<B: BoundingVolume>(
         .flat_map(|e| e.as_bytes().iter().copied())
         .collect();
     header.header_crc = header_crc(header.as_bytes(), &directory).into();
-    bytes[..HEADER_SIZE].copy_from_slice(header.as_bytes());
-    bytes[HEADER_SIZE..header_bytes].copy_from_slice(&directory);
-    Ok(ObbtFile::from_aligned(image).expect("the writer lays out a valid header and directory"))
+    let mut head = header.as_bytes().to_vec();
+    head.extend_from_slice(&directory);
+    bytes
+        .get_mut(..head.len())
+        .ok_or_else(layout_error)?
+        .copy_from_slice(&head);
+    // The reader's O(1) checks double as a check of the writer.
+    ObbtFile::from_aligned(image)
+        .map_err(|e| BuildError::Image(format!("the written header fails its own checks: {e}")))
 }
 
 /// Encodes the nodes of `tree` into `out` (exactly their size) and returns its CRC-32.
@@ -128,7 +168,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
 /// `CHUNK` nodes (cut at the same places whatever the number of threads), each run's CRC
 /// taken while its bytes are still in cache and the CRCs combined in order. The first
 /// reference (in node order) that the encoding cannot hold is the error.
-fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result<u32, EncodeError> {
+fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result<u32, BuildError> {
     const CHUNK: usize = 2048;
     let size = Node::<B>::SIZE;
     // (drafts, their shift, output) of each run, in order.
@@ -137,13 +177,19 @@ fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result
     for piece in &tree.nodes {
         let (drafts, shift) = piece.raw();
         for drafts in drafts.chunks(CHUNK) {
-            let (o, rest) = std::mem::take(&mut out).split_at_mut(drafts.len() * size);
+            let Some((o, rest)) =
+                std::mem::take(&mut out).split_at_mut_checked(drafts.len().saturating_mul(size))
+            else {
+                return Err(BuildError::Image(
+                    "more nodes than the node section holds".into(),
+                ));
+            };
             runs.push((drafts, shift, o));
             out = rest;
         }
     }
     let encoding = tree.encoding;
-    let hashers: Vec<Result<crc32fast::Hasher, EncodeError>> = runs
+    let hashers: Vec<Result<crc32fast::Hasher, BuildError>> = runs
         .into_par_iter()
         .map(|(drafts, shift, out)| {
             let mut record = Vec::with_capacity(size);
@@ -165,33 +211,14 @@ fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result
     Ok(crc.finalize())
 }
 
-/// The four section slices of `bytes` at the (ascending, disjoint) `ranges`.
-fn sections_mut<'a>(bytes: &'a mut [u8], ranges: &[Range<usize>]) -> [&'a mut [u8]; 4] {
-    let mut rest = bytes;
-    let mut consumed = 0;
-    let mut out: [&mut [u8]; 4] = Default::default();
-    for (slot, range) in out.iter_mut().zip(ranges) {
-        let (_, tail) = std::mem::take(&mut rest).split_at_mut(range.start - consumed);
-        let (section, tail) = tail.split_at_mut(range.len());
-        *slot = section;
-        rest = tail;
-        consumed = range.end;
-    }
-    out
-}
-
 /// Writes the little-endian encoding of `x` into `out` (exactly its size).
 #[inline]
 fn put_real<R: Real>(x: R, out: &mut [u8]) {
     match R::PRECISION {
         // Widening to f64 is exact, so narrowing back gives `x` itself.
-        Precision::F32 => out.copy_from_slice(&(x.to_f64() as f32).to_le_bytes()),
+        Precision::F32 => out.copy_from_slice(&f32::from_f64_nearest(x.to_f64()).to_le_bytes()),
         Precision::F64 => out.copy_from_slice(&x.to_f64().to_le_bytes()),
     }
-}
-
-fn align64(n: u64) -> u64 {
-    align_up(n).expect("section sizes are bounded by memory")
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed to

@@ -3,6 +3,13 @@
 //! Every loader ends in the same checks as [`TriMesh::new`], so a `TriMesh`
 //! always satisfies its invariants however it was made.
 
+// Everything here parses untrusted files: on top of the crate's no-panic lints, integer
+// arithmetic must be checked or saturating and narrowing casts must be `try_from`.
+#![cfg_attr(
+    not(test),
+    deny(clippy::arithmetic_side_effects, clippy::cast_possible_truncation)
+)]
+
 mod error;
 mod limits;
 mod load;

@@ -23,7 +23,7 @@ impl Welder {
     /// checked against the caps and the input size.
     pub(crate) fn with_capacity(triangles: usize) -> Welder {
         // A closed mesh has about half as many vertices as triangles.
-        let vertices = triangles / 2 + 3;
+        let vertices = (triangles / 2).saturating_add(3);
         Welder {
             ids: HashMap::with_capacity(vertices),
             vertices: Vec::with_capacity(vertices),

@@ -175,17 +175,26 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
             }
         }
         if P::ORDERED {
-            // Most promising last, so it is popped first. Children counts are small (2 in
-            // binary trees), so an insertion sort on the tail is cheapest.
-            let tail = &mut stack[start..];
-            for i in 1..tail.len() {
-                let mut j = i;
-                while j > 0 && tail[j - 1].key < tail[j].key {
-                    tail.swap(j - 1, j);
-                    j -= 1;
-                }
+            // Most promising last, so it is popped first.
+            if let Some(tail) = stack.get_mut(start..) {
+                sort_descending(tail);
             }
         }
     }
     Ok(stats)
+}
+
+/// Sorts pending pairs by decreasing key, stably. Children counts are small (2 in binary
+/// trees), so an insertion sort is cheapest.
+#[inline(always)]
+// why: `j - 1` and `j` lie in `0..tail.len()` (`1 <= j <= i < tail.len()`).
+#[allow(clippy::indexing_slicing)]
+fn sort_descending(tail: &mut [Pending]) {
+    for i in 1..tail.len() {
+        let mut j = i;
+        while j > 0 && tail[j - 1].key < tail[j].key {
+            tail.swap(j - 1, j);
+            j -= 1;
+        }
+    }
 }

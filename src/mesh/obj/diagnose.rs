@@ -20,7 +20,7 @@ pub(super) fn rejection(text: &str, file: &str, vertex_count: usize) -> Option<M
                     let message = format!("bad vertex coordinate {}", quote(bad));
                     return Some(MeshError::syntax(file, line, message));
                 }
-                vertices_so_far += 1;
+                vertices_so_far = vertices_so_far.saturating_add(1);
             }
             Some("f") => {
                 let place = || Place::new(file, Location::Line(line));

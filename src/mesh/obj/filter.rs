@@ -42,13 +42,13 @@ pub(super) fn build(text: &str, file: &str) -> Result<TobjInput, MeshError> {
                     let count = MAX_VERTICES + 1;
                     return Err(MeshError::too_large(file, "vertices", count, MAX_VERTICES));
                 }
-                vertex_count += 1;
+                vertex_count = vertex_count.saturating_add(1); // below the cap, just checked
                 body.push('v');
-                let mut coordinates = 0;
+                let mut coordinates: usize = 0;
                 for word in words.take(3) {
                     body.push(' ');
                     body.push_str(word);
-                    coordinates += 1;
+                    coordinates = coordinates.saturating_add(1);
                 }
                 if coordinates < 3 {
                     let message = format!("vertex needs 3 coordinates, found {coordinates}");
@@ -68,13 +68,13 @@ pub(super) fn build(text: &str, file: &str) -> Result<TobjInput, MeshError> {
                     }
                     body.push(' ');
                     body.push_str(position);
-                    corners += 1;
+                    corners = corners.saturating_add(1);
                 }
                 if corners < 3 {
                     let message = format!("face has {corners} vertices, needs at least 3");
                     return Err(MeshError::syntax(file, line, message));
                 }
-                triangle_count = triangle_count.saturating_add(corners - 2);
+                triangle_count = triangle_count.saturating_add(corners.saturating_sub(2));
                 if triangle_count > MAX_TRIANGLES {
                     return Err(MeshError::too_large(
                         file,

@@ -66,7 +66,8 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<TriMesh, MeshError> {
     }
     let mut welder = Welder::with_capacity(records.len());
     for (id, record) in records.iter().enumerate() {
-        let record_offset = HEADER_LEN + id * RECORD_LEN;
+        // Within the file, whose length was checked against the count.
+        let record_offset = id.saturating_mul(RECORD_LEN).saturating_add(HEADER_LEN);
         let corners = corners_of(record, record_offset, file)?;
         welder
             .push_triangle(corners)
@@ -88,7 +89,10 @@ fn corners_of(
         for (axis, (value, coordinate)) in stored.iter().zip(out).enumerate() {
             let value = f64::from(value.get());
             if !value.is_finite() {
-                let offset = record_offset + CORNERS_OFFSET + 12 * corner + 4 * axis;
+                let offset = record_offset
+                    .saturating_add(CORNERS_OFFSET)
+                    .saturating_add(corner.saturating_mul(12))
+                    .saturating_add(axis.saturating_mul(4));
                 return Err(MeshError::NonFinite {
                     place: Place::new(file, Location::Byte(offset as u64)),
                     value,
