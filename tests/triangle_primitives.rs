@@ -953,6 +953,33 @@ fn extreme_magnitudes_never_nan() {
     }
 }
 
+/// Regression: a corner at infinity (an unverified, damaged file, or a pose that overflows
+/// huge coordinates) used to make both primitives rescale by 2^-inf and call themselves for
+/// ever (a stack overflow). Infinite pairs do not touch and are infinitely far apart; NaN
+/// corners give some answer, but always return.
+#[test]
+fn non_finite_corners_terminate() {
+    let inf = f64::INFINITY;
+    for bad in [inf, -inf, f64::NAN] {
+        for corner in 0..3 {
+            for axis in 0..3 {
+                let mut a = unit();
+                a[corner][axis] = bad;
+                let b = unit();
+                for (x, y) in [(&a, &b), (&b, &a)] {
+                    let hit = triangles_intersect(x, y);
+                    let d = triangle_distance(x, y);
+                    let _ = triangle_max_distance(x, y);
+                    if bad.is_infinite() {
+                        assert!(!hit, "{bad} at corner {corner} axis {axis}");
+                        assert_eq!(d.distance, inf, "{bad} at corner {corner} axis {axis}");
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn max_distance_known() {
     let a = unit();

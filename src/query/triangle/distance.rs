@@ -31,11 +31,21 @@ type V = Vector3<f64>;
 ///
 /// Never NaN and never panics for finite inputs (pairs whose largest coordinate lies outside
 /// 1e-60..1e60 are solved scaled by a power of two; the distance may then overflow to
-/// infinity near `f64::MAX`); no allocation.
+/// infinity near `f64::MAX`); a pair with an infinite corner is at infinite distance. It
+/// always terminates and needs no allocation.
 #[inline]
 pub fn triangle_distance(a: &Triangle, b: &Triangle) -> TriangleDistance {
     let m = max_abs(a, b);
     if !in_range(m) {
+        // Rescaling infinity would recurse for ever: a pair with an infinite corner (a
+        // damaged, unverified file, or a pose that overflows) is infinitely far apart.
+        if !m.is_finite() {
+            return TriangleDistance {
+                distance: f64::INFINITY,
+                point_a: a[0],
+                point_b: b[0],
+            };
+        }
         return distance_rescaled(a, b, m);
     }
     // Which pair of witnesses answers first depends on the argument order; solving in a

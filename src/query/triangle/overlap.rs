@@ -21,8 +21,9 @@ type V = Vector3<f64>;
 /// exact coordinate projections), evaluated exactly with Shewchuk's adaptive arithmetic, so it
 /// is the exact answer for the f64 coordinates given (no tolerance). Pairs whose largest
 /// coordinate lies outside 1e-60..1e60 are first scaled by a power of two (exact), so the
-/// answer stays exact unless the coordinates span hundreds of orders of magnitude. It never
-/// panics and needs no allocation.
+/// answer stays exact unless the coordinates span hundreds of orders of magnitude. A pair
+/// with an infinite coordinate does not intersect (NaN corners give an unspecified answer).
+/// It never panics, always terminates and needs no allocation.
 ///
 /// Cost: an exact bounding-box rejection, then the three corners of `b` against the plane of
 /// `a` (early out when all lie strictly on one side), then the corners of `a` against the plane
@@ -36,9 +37,20 @@ pub fn triangles_intersect(a: &Triangle, b: &Triangle) -> bool {
     }
     let m = max_abs(a, b);
     if !in_range(m) {
+        // An infinite corner (a damaged, unverified file, or a pose that overflows) spans no
+        // closed set: no contact. Checked here, since rescaling infinity would never end.
+        if !m.is_finite() {
+            return false;
+        }
         let (a, b, _) = rescale(a, b, m);
-        return triangles_intersect(&a, &b);
+        return intersect_in_range(&a, &b);
     }
+    intersect_in_range(a, b)
+}
+
+/// [`triangles_intersect`] once the boxes overlap and the coordinates are in range.
+#[inline(always)]
+fn intersect_in_range(a: &Triangle, b: &Triangle) -> bool {
     let pa = PlaneSide::new(a);
     // Signs of b's corners against a's plane: early out when all strictly on one side.
     let db = b.each_ref().map(|q| pa.side(a, q));
