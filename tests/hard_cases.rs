@@ -1020,3 +1020,39 @@ fn the_cube_gets_a_tight_box_in_any_orientation() {
         );
     }
 }
+
+/// Models so far apart that their distance overflows f64 (valid poses, valid files): the
+/// distance is infinite, not an error. Regression: every pair's distance and bound was
+/// infinite, nothing beat the initial "no pair yet" value, and the query reported a
+/// corrupt tree. Models far apart but within range get their exact, finite distance
+/// quickly (the bound is tight far away, so only a few leaf pairs are measured).
+#[test]
+fn distances_beyond_the_f64_range_are_infinite_not_errors() {
+    let mut context = QueryContext::new();
+    for options in common::all_options() {
+        let cube = built(&common::cube(1.0), &options);
+        let overflow = shifted(-1.7e308, 1.7e308, 0.0);
+        let d = distance_files(
+            &cube,
+            &Pose::identity(),
+            &cube,
+            &overflow,
+            &DistanceOptions::default(),
+            &mut context,
+        )
+        .expect("an answer");
+        assert_eq!(d.distance, f64::INFINITY, "{options:?}");
+        let far = shifted(1e300, 0.0, 0.0);
+        let d = distance_files(
+            &cube,
+            &Pose::identity(),
+            &cube,
+            &far,
+            &DistanceOptions::default(),
+            &mut context,
+        )
+        .expect("an answer");
+        assert_eq!(d.distance, 1e300, "{options:?}");
+        assert!(d.stats.tri_separated <= 16, "{options:?}: {:?}", d.stats);
+    }
+}

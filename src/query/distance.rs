@@ -60,7 +60,8 @@ struct Best {
     distance: f64,
     point_a: Vector3<f64>,
     point_b: Vector3<f64>,
-    faces: (u32, u32),
+    /// The leaf-ordered faces of the pair; `None` until a pair is measured.
+    faces: Option<(u32, u32)>,
 }
 
 struct Distance {
@@ -69,6 +70,8 @@ struct Distance {
     /// Stop as soon as a pair is closer than this (tolerance queries); `-1` otherwise.
     stop_below: f64,
     best: Best,
+    /// No pair measured yet in a distance query (tolerance queries prune from the start).
+    unmeasured: bool,
 }
 
 impl<B: BoundingVolume> Policy<B> for Distance {
@@ -82,7 +85,9 @@ impl<B: BoundingVolume> Policy<B> for Distance {
     #[inline]
     fn keep(&self, key: f64) -> bool {
         let best = self.best.distance;
-        key * (1.0 + self.rel_err) < best && key + self.abs_err < best
+        // Until a first pair is measured nothing is pruned: a pose far enough out overflows
+        // every bound to infinity, and the answer is then an infinite distance, not none.
+        (key * (1.0 + self.rel_err) < best && key + self.abs_err < best) || self.unmeasured
     }
 
     #[inline]
@@ -100,12 +105,16 @@ impl<B: BoundingVolume> Policy<B> for Distance {
         } else {
             stats.tri_separated += 1;
         }
-        if d.distance < self.best.distance {
+        let first = self.unmeasured && !d.distance.is_nan();
+        if first {
+            self.unmeasured = false;
+        }
+        if d.distance < self.best.distance || first {
             self.best = Best {
                 distance: d.distance,
                 point_a: d.point_a,
                 point_b: d.point_b,
-                faces: (fa, fb),
+                faces: Some((fa, fb)),
             };
             if d.distance == 0.0 || d.distance < self.stop_below {
                 return Flow::Stop;
@@ -139,15 +148,15 @@ fn run<B: BoundingVolume>(
     let xf = Pose::relative(pose_a, pose_b);
     let stats = traverse(a, b, &xf, rule, &mut policy, context)?;
     let best = policy.best;
-    if !best.distance.is_finite() {
+    let Some(faces) = best.faces else {
         return Ok((None, stats));
-    }
+    };
     let result = DistanceResult {
         distance: best.distance,
         point_a: pose_a.apply(&best.point_a),
         point_b: pose_a.apply(&best.point_b),
-        tri_a: source_id(a, best.faces.0, 'A')?,
-        tri_b: source_id(b, best.faces.1, 'B')?,
+        tri_a: source_id(a, faces.0, 'A')?,
+        tri_b: source_id(b, faces.1, 'B')?,
         stats,
     };
     Ok((Some(result), stats))
@@ -168,13 +177,14 @@ pub fn distance<B: BoundingVolume>(
         distance: f64::INFINITY,
         point_a: Vector3::zeros(),
         point_b: Vector3::zeros(),
-        faces: (0, 0),
+        faces: None,
     };
     let policy = Distance {
         rel_err: options.rel_err,
         abs_err: options.abs_err,
         stop_below: -1.0,
         best: none,
+        unmeasured: true,
     };
     let (result, _) = run(a, pose_a, b, pose_b, policy, options.rule, context)?;
     // Every tree has a face, so some triangle pair was measured unless the tree is corrupt.
@@ -200,13 +210,14 @@ pub fn within_tolerance<B: BoundingVolume>(
         distance: tolerance,
         point_a: Vector3::zeros(),
         point_b: Vector3::zeros(),
-        faces: (0, 0),
+        faces: None,
     };
     let policy = Distance {
         rel_err: 0.0,
         abs_err: 0.0,
         stop_below: tolerance,
         best: start,
+        unmeasured: false,
     };
     let mut found = None;
     let (result, stats) = run(a, pose_a, b, pose_b, policy, rule, context)?;
