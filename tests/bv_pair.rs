@@ -185,3 +185,33 @@ fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
     );
     assert!(pair.disjoint(0.0));
 }
+
+/// Boxes far apart along a diagonal: the separating-axis gaps alone reach only about 1/√3
+/// of the distance (which made distance queries between far-apart models visit nearly
+/// every leaf pair); the centre-to-box bound brings the lower bound within the boxes'
+/// circumradius of the distance.
+#[test]
+fn far_apart_boxes_along_a_diagonal_have_a_tight_lower_bound() {
+    let unit = Vector3::repeat(0.01);
+    let a = obb(Matrix3::identity(), Vector3::zeros(), unit);
+    let b = obb(rotation(0.3, -0.2, 0.5), Vector3::zeros(), unit);
+    for far in [1.0, 10.0, 1e3, 1e300] {
+        let xf = Transform {
+            rotation: Matrix3::identity(),
+            translation: Vector3::repeat(far),
+        };
+        let centres = 3f64.sqrt() * far;
+        let lb = a.distance_lower_bound(&b, &xf);
+        // Each box lies within 0.01·√3 of its centre.
+        let slack = 2.0 * 0.01 * 3f64.sqrt();
+        // Up to the rounding of the centres' distance itself.
+        assert!(
+            lb <= centres * (1.0 + 1e-15),
+            "{far}: {lb} exceeds the centre distance {centres}"
+        );
+        assert!(
+            lb >= centres - slack - 1e-12 * centres,
+            "{far}: {lb} is not within {slack} of {centres}"
+        );
+    }
+}
