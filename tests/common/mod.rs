@@ -1,6 +1,8 @@
 //! Meshes generated in code, shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod mutate;
+
 use obbtree::mesh::TriMesh;
 
 /// A latitude/longitude sphere of `2 * slices * (stacks - 1)` triangles, like the spheres of

@@ -1,0 +1,355 @@
+//! Hostile `.obbt` images for the robustness suites: seeded byte flips, truncations, and
+//! header, directory and node fields rewritten with extreme values, optionally re-sealed
+//! (checksums recomputed) so that the damage gets past the checksums and reaches the
+//! structural checks of `open` and `verify`, and the queries.
+//!
+//! Also [`exercise`]: open, query (unverified), verify, and when the damaged file verifies,
+//! compare its collision answer with a brute force over the file's own triangles.
+
+use obbtree::bv::pair::Transform;
+use obbtree::bv::BoundingVolume;
+use obbtree::format::layout::{
+    header_crc, ENTRY_SIZE, HEADER_CRC_OFFSET, HEADER_SIZE, MAX_SECTIONS,
+};
+use obbtree::format::{AlignedBytes, ObbtFile, TreeVisitor};
+use obbtree::query::{
+    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
+    DistanceOptions, Pose, QueryContext,
+};
+use obbtree::tree::TreeView;
+
+/// A seeded xorshift generator: the same seed gives the same mutations on every machine.
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed (any value).
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    /// A number in `0..n` (`n > 0`).
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+}
+
+/// Header fields as (name, byte offset, width in bytes), from `formats/obbt.md` § Header.
+/// The signature and the CRC are left out: rewriting them only exercises the first check.
+pub const HEADER_FIELDS: [(&str, usize, usize); 20] = [
+    ("version_major", 8, 2),
+    ("version_minor", 10, 2),
+    ("header_bytes", 12, 4),
+    ("file_bytes", 16, 8),
+    ("bv_kind", 24, 1),
+    ("precision", 25, 1),
+    ("encoding", 26, 1),
+    ("fit_method", 27, 1),
+    ("leaf_size", 28, 2),
+    ("section_count", 30, 2),
+    ("triangles", 32, 4),
+    ("vertices", 36, 4),
+    ("nodes", 40, 4),
+    ("leaves", 44, 4),
+    ("depth", 48, 4),
+    ("degenerate_triangles", 52, 4),
+    ("max_leaf_faces", 56, 4),
+    ("reserved0", 60, 4),
+    ("bounds_min.x", 64, 8),
+    ("bounds_max.z", 104, 8),
+];
+
+/// Directory entry fields as (name, offset within the entry, width in bytes).
+pub const ENTRY_FIELDS: [(&str, usize, usize); 6] = [
+    ("kind", 0, 4),
+    ("flags", 4, 4),
+    ("offset", 8, 8),
+    ("length", 16, 8),
+    ("count", 24, 8),
+    ("stride", 32, 4),
+];
+
+/// Reads a little-endian unsigned integer of `width` bytes at `at`.
+pub fn read_uint(bytes: &[u8], at: usize, width: usize) -> u64 {
+    let mut v = [0u8; 8];
+    v[..width].copy_from_slice(&bytes[at..at + width]);
+    u64::from_le_bytes(v)
+}
+
+/// Writes the low `width` bytes of `value`, little-endian, at `at`.
+pub fn write_uint(bytes: &mut [u8], at: usize, width: usize, value: u64) {
+    bytes[at..at + width].copy_from_slice(&value.to_le_bytes()[..width]);
+}
+
+/// Values at the edges of a field of `width` bytes, plus ones near `file_len` (for offsets
+/// and lengths), each truncated to the field.
+pub fn extreme_values(width: usize, file_len: u64) -> Vec<u64> {
+    let max = if width == 8 {
+        u64::MAX
+    } else {
+        (1u64 << (8 * width)) - 1
+    };
+    let mut values = vec![
+        0,
+        1,
+        2,
+        3,
+        4,
+        7,
+        8,
+        63,
+        64,
+        65,
+        128,
+        255,
+        max / 2,
+        max / 2 + 1,
+        max - 63,
+        max - 1,
+        max,
+        file_len - 64,
+        file_len - 1,
+        file_len,
+        file_len + 1,
+        file_len + 64,
+        u64::from(u32::MAX),
+        u64::from(u32::MAX) + 1,
+        u64::MAX / 12 + 1,
+        u64::MAX / 64 + 1,
+    ];
+    for v in &mut values {
+        *v &= max;
+    }
+    values.sort_unstable();
+    values.dedup();
+    values
+}
+
+/// The number of directory entries the header declares, if the header is there.
+fn section_count(bytes: &[u8]) -> Option<usize> {
+    (bytes.len() >= HEADER_SIZE).then(|| read_uint(bytes, 30, 2) as usize)
+}
+
+/// Byte offset of directory entry `index`.
+pub fn entry_offset(index: usize) -> usize {
+    HEADER_SIZE + ENTRY_SIZE * index
+}
+
+/// Recomputes every checksum that can be recomputed: each section's CRC whose bytes are in
+/// bounds, then the header CRC. What remains wrong is then caught only by the structural
+/// checks, which is what these suites want to reach.
+pub fn seal(bytes: &mut [u8]) {
+    let Some(count) = section_count(bytes) else {
+        return;
+    };
+    let count = count.min(usize::from(MAX_SECTIONS));
+    for index in 0..count {
+        let e = entry_offset(index);
+        if e + ENTRY_SIZE > bytes.len() {
+            break;
+        }
+        let offset = read_uint(bytes, e + 8, 8);
+        let length = read_uint(bytes, e + 16, 8);
+        if let Some(end) = offset
+            .checked_add(length)
+            .filter(|&end| end <= bytes.len() as u64)
+        {
+            let crc = crc32fast::hash(&bytes[offset as usize..end as usize]);
+            write_uint(bytes, e + 36, 4, u64::from(crc));
+        }
+    }
+    let directory_end = entry_offset(count).min(bytes.len());
+    let crc = header_crc(&bytes[..HEADER_SIZE], &bytes[HEADER_SIZE..directory_end]);
+    write_uint(bytes, HEADER_CRC_OFFSET, 4, u64::from(crc));
+}
+
+/// Where an image was stopped, or that it answered.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Outcome {
+    /// `open` accepted the header and directory.
+    pub opened: bool,
+    /// Queries on the unverified file that returned an answer (of 6).
+    pub answered: u32,
+    /// Queries on the unverified file that returned an error (of 6).
+    pub refused: u32,
+    /// `verify` accepted the file.
+    pub verified: bool,
+}
+
+/// Tallies of many outcomes, for the closing report of a suite.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Tally {
+    /// Images tried.
+    pub tried: u64,
+    /// Refused by `open`.
+    pub refused_by_open: u64,
+    /// Opened, then refused by `verify`.
+    pub refused_by_verify: u64,
+    /// Opened and verified (their answers were checked against brute force when asked).
+    pub accepted: u64,
+    /// Queries on opened, unverified images that answered.
+    pub queries_answered: u64,
+    /// Queries on opened, unverified images that returned an error.
+    pub queries_refused: u64,
+}
+
+impl Tally {
+    /// Counts one outcome.
+    pub fn add(&mut self, o: Outcome) {
+        self.tried += 1;
+        match (o.opened, o.verified) {
+            (false, _) => self.refused_by_open += 1,
+            (true, false) => self.refused_by_verify += 1,
+            (true, true) => self.accepted += 1,
+        }
+        self.queries_answered += u64::from(o.answered);
+        self.queries_refused += u64::from(o.refused);
+    }
+
+    /// Sums two tallies.
+    pub fn merge(mut self, other: Tally) -> Tally {
+        self.tried += other.tried;
+        self.refused_by_open += other.refused_by_open;
+        self.refused_by_verify += other.refused_by_verify;
+        self.accepted += other.accepted;
+        self.queries_answered += other.queries_answered;
+        self.queries_refused += other.queries_refused;
+        self
+    }
+}
+
+/// The poses of B in the queries of [`exercise`], for models of a given size: A stays at
+/// the identity. Chosen so that every query has work to do on an intact file, but not so
+/// much that a large sample takes long.
+#[derive(Clone, Debug)]
+pub struct Poses {
+    /// Collision: rotated, shifted by 0.9 sizes along x (a shallow overlap).
+    pub collide: Pose,
+    /// Distance and tolerance: shifted by 1.05 sizes along x (a gap of a few percent).
+    pub distance: Pose,
+    /// Span: rotated and shifted by 0.15 sizes.
+    pub span: Pose,
+    /// Tolerance of the "closer than t" query: a tenth of the size.
+    pub tolerance: f64,
+}
+
+impl Poses {
+    /// Poses for models whose largest extent is `size` model units.
+    pub fn for_size(size: f64) -> Poses {
+        let r = *nalgebra::Rotation3::from_euler_angles(0.3, -0.2, 0.5).matrix();
+        let pose = |x: f64| Pose::new(r, nalgebra::Vector3::new(x, -0.05 * size, 0.1 * size));
+        Poses {
+            collide: pose(0.9 * size).expect("a rotation"),
+            distance: Pose::translation(1.05 * size, 0.0, 0.0),
+            span: pose(0.15 * size).expect("a rotation"),
+            tolerance: 0.1 * size,
+        }
+    }
+
+    /// Poses for the models of `file`, sized from its header bounds.
+    pub fn for_file(file: &ObbtFile) -> Poses {
+        let info = file.info();
+        let size = (0..3)
+            .map(|k| info.bounds_max[k] - info.bounds_min[k])
+            .fold(0.0, f64::max);
+        Poses::for_size(size)
+    }
+}
+
+/// Opens `bytes`, runs every query kind on the unverified file (against itself and against
+/// `partner`), then verifies it. With `check_answers`, a file that verifies must give the
+/// brute-force collision answer over its own triangles. Any panic is a failure of the
+/// caller's test.
+pub fn exercise(bytes: &[u8], partner: &ObbtFile, poses: &Poses, check_answers: bool) -> Outcome {
+    let mut outcome = Outcome::default();
+    let Ok(file) = ObbtFile::from_aligned(AlignedBytes::copy_from(bytes)) else {
+        return outcome;
+    };
+    outcome.opened = true;
+    let _ = file.info();
+    let id = Pose::identity();
+    let mut context = QueryContext::new();
+    let mut count = |ok: bool| {
+        if ok {
+            outcome.answered += 1;
+        } else {
+            outcome.refused += 1;
+        }
+    };
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
+    let all = CollideOptions::default();
+    let (d, rule) = (DistanceOptions::default(), DescentRule::default());
+    let c = &mut context;
+    count(collide_files(&file, &id, &file, &poses.collide, &all, c).is_ok());
+    count(collide_files(&file, &id, partner, &poses.span, &first, c).is_ok());
+    count(distance_files(&file, &id, &file, &poses.distance, &d, c).is_ok());
+    count(distance_files(partner, &id, &file, &poses.collide, &d, c).is_ok());
+    let t = poses.tolerance;
+    count(within_tolerance_files(&file, &id, &file, &poses.distance, t, rule, c).is_ok());
+    count(span_files(&file, &id, &file, &poses.span, rule, c).is_ok());
+    outcome.verified = file.verify().is_ok();
+    if outcome.verified && check_answers {
+        let got = collide_files(&file, &id, &file, &poses.collide, &all, c)
+            .expect("a verified file answers");
+        let expected = brute_force_pairs(&file, &id, &file, &poses.collide);
+        assert_eq!(
+            got.pairs, expected,
+            "a damaged file that verifies must still answer exactly for what it stores"
+        );
+    }
+    outcome
+}
+
+/// The input-mesh id and model-frame corners of every face of a file.
+pub fn file_triangles(file: &ObbtFile) -> Vec<(u32, [[f64; 3]; 3])> {
+    struct Faces;
+    impl TreeVisitor for Faces {
+        type Output = Vec<(u32, [[f64; 3]; 3])>;
+        fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
+            (0..tree.faces().len() as u32)
+                .filter_map(|f| Some((tree.source_id(f)?, tree.triangle(f)?)))
+                .collect()
+        }
+    }
+    file.visit(Faces).expect("a view of the file's own type")
+}
+
+/// Every contacting pair of two posed files by testing all pairs, B mapped into A's frame
+/// exactly as the queries map it; sorted input-mesh ids.
+pub fn brute_force_pairs(
+    a: &ObbtFile,
+    pose_a: &Pose,
+    b: &ObbtFile,
+    pose_b: &Pose,
+) -> Vec<(u32, u32)> {
+    let xf: Transform = Pose::relative(pose_a, pose_b);
+    let to_vectors = |t: &[[f64; 3]; 3]| t.map(nalgebra::Vector3::from);
+    let ta: Vec<_> = file_triangles(a)
+        .iter()
+        .map(|(id, t)| (*id, to_vectors(t)))
+        .collect();
+    let tb: Vec<_> = file_triangles(b)
+        .iter()
+        .map(|(id, t)| (*id, to_vectors(t).map(|p| xf.apply(&p))))
+        .collect();
+    let mut pairs: Vec<(u32, u32)> = ta
+        .iter()
+        .flat_map(|(ia, a)| {
+            tb.iter().filter_map(move |(ib, b)| {
+                obbtree::query::triangle::triangles_intersect(a, b).then_some((*ia, *ib))
+            })
+        })
+        .collect();
+    pairs.sort_unstable();
+    pairs
+}
