@@ -237,3 +237,30 @@ fn files_and_views_can_be_shared_between_threads() {
     shared::<TreeView<'static, Sphere<f64>>>();
     shared::<obbtree::query::QueryContext>();
 }
+
+/// Regression (found by fuzzing): a coordinate beyond the f32 range rounded to infinity and
+/// gave an f32 file that its own verify refused. It is now a build error that names the
+/// vertex and the way out; the f64 file is fine.
+#[test]
+fn coordinates_beyond_f32_are_a_build_error_for_f32_files() {
+    let mesh = obbtree::mesh::TriMesh::new(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1e39, 0.0]],
+        vec![[0, 1, 2]],
+    )
+    .expect("a valid mesh");
+    let err = build(&mesh, &BuildOptions::default(), None)
+        .expect_err("f32 cannot hold 1e39")
+        .to_string();
+    assert!(
+        err.contains("vertex 2") && err.contains("--precision f64"),
+        "{err}"
+    );
+    let options = BuildOptions {
+        precision: obbtree::real::Precision::F64,
+        ..BuildOptions::default()
+    };
+    build(&mesh, &options, None)
+        .expect("f64 holds it")
+        .verify()
+        .expect("verifies");
+}

@@ -70,6 +70,16 @@ pub enum BuildError {
     /// can address (32-bit hosts), or (a bug) the header written fails the reader's checks.
     #[error("cannot lay out the .obbt image: {0}")]
     Image(String),
+    /// A coordinate is too large for the stored precision (beyond about 3.4e38 in f32).
+    #[error("vertex {vertex} coordinate {value:e} does not fit the stored {precision} precision (it rounds to infinity); build with --precision f64")]
+    CoordinateOverflow {
+        /// Index of the vertex (0-based, input order).
+        vertex: usize,
+        /// The input coordinate.
+        value: f64,
+        /// `f32` or `f64`.
+        precision: &'static str,
+    },
 }
 
 /// Builds the tree of `mesh` and lays it out as a complete `.obbt` image in memory (the same
@@ -122,6 +132,24 @@ fn build_as<B: BoundingVolume>(
         .map(|p| p.map(<B::Real as Real>::from_f64_nearest))
         .collect();
     let positions: Vec<[f64; 3]> = stored.iter().map(crate::real::point_to_f64).collect();
+    // Input coordinates are finite (TriMesh checks), but f32 rounds beyond 3.4e38 to infinity,
+    // which would give a file that its own verify refuses.
+    let overflow =
+        positions
+            .iter()
+            .zip(mesh.vertices())
+            .enumerate()
+            .find_map(|(vertex, (p, input))| {
+                let k = p.iter().position(|c| !c.is_finite())?;
+                Some((vertex, input.get(k).copied().unwrap_or(f64::INFINITY)))
+            });
+    if let Some((vertex, value)) = overflow {
+        return Err(BuildError::CoordinateOverflow {
+            vertex,
+            value,
+            precision: <B::Real as Real>::PRECISION.name(),
+        });
+    }
     // The statistics that do not depend on the tree are found alongside it.
     let (draft, (degenerate, bounds)) = rayon::join(
         || topdown::build_drafts::<B>(&positions, mesh.faces(), options, progress),
