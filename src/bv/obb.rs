@@ -126,10 +126,12 @@ pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 }
 
 /// Orthonormality tolerance of stored axes: rounding each component to f32 moves a dot
-/// product by about 2e-7, so 1e-5 accepts every rounded frame and rejects real damage.
+/// product by about 2e-7, so 1e-6 accepts every rounded frame and rejects real damage. It
+/// must not exceed the guard of the pair tests ([`crate::bv::pair::SAT_GUARD`]), whose
+/// slack keeps them conservative only for frames orthonormal within it.
 pub(crate) fn axis_tolerance(precision: Precision) -> f64 {
     match precision {
-        Precision::F32 => 1e-5,
+        Precision::F32 => 1e-6,
         Precision::F64 => 1e-10,
     }
 }

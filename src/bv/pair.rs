@@ -74,6 +74,12 @@ impl BoxPair {
     /// Whether the boxes are disjoint, by the 15 separating axes of §4.3, with `guard` added
     /// to the absolute rotation entries ([`SAT_GUARD`] in queries; 0 only to demonstrate why
     /// the guard is needed). Conservative: overlapping boxes are never reported disjoint.
+    ///
+    /// Every comparison also gets the slack [`frame_slack`]: box axes stored in f32 are
+    /// orthonormal only to about 1e-7, an error that scales with the boxes' extents and the
+    /// distance between their centres. The rotation guard covers it only through the other
+    /// box's half-widths, so a thin box (a single triangle, a sliver) touching another could
+    /// be reported disjoint and a contact lost (found by fuzzing).
     #[inline]
     // why: 3x3 matrix / 3-vector entries indexed by axis numbers in 0..3 (loop counters and
     // their cyclic successors); the hottest test of every query, kept in the book's form.
@@ -81,10 +87,11 @@ impl BoxPair {
     pub fn disjoint(&self, guard: f64) -> bool {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs().add_scalar(guard);
+        let slack = frame_slack(guard, a, b, t);
         // A's face axes.
         for i in 0..3 {
             let rb = b[0] * abs[(i, 0)] + b[1] * abs[(i, 1)] + b[2] * abs[(i, 2)];
-            if t[i].abs() > a[i] + rb {
+            if t[i].abs() > a[i] + rb + slack {
                 return true;
             }
         }
@@ -92,7 +99,7 @@ impl BoxPair {
         for j in 0..3 {
             let ra = a[0] * abs[(0, j)] + a[1] * abs[(1, j)] + a[2] * abs[(2, j)];
             let tj = t[0] * m[(0, j)] + t[1] * m[(1, j)] + t[2] * m[(2, j)];
-            if tj.abs() > ra + b[j] {
+            if tj.abs() > ra + b[j] + slack {
                 return true;
             }
         }
@@ -104,7 +111,7 @@ impl BoxPair {
                 let ra = a[i1] * abs[(i2, j)] + a[i2] * abs[(i1, j)];
                 let rb = b[j1] * abs[(i, j2)] + b[j2] * abs[(i, j1)];
                 let tl = t[i2] * m[(i1, j)] - t[i1] * m[(i2, j)];
-                if tl.abs() > ra + rb {
+                if tl.abs() > ra + rb + slack {
                     return true;
                 }
             }
@@ -131,23 +138,25 @@ impl BoxPair {
     pub fn distance_lower_bound(&self) -> f64 {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs();
+        // Each term is lowered by the frame slack, as `disjoint` raises its radii by it.
+        let slack = frame_slack(SAT_GUARD, a, b, t);
         let mut best = 0.0f64;
         let mut beyond_a = Vector3::zeros();
         for i in 0..3 {
             let rb = b[0] * abs[(i, 0)] + b[1] * abs[(i, 1)] + b[2] * abs[(i, 2)];
-            best = best.max(t[i].abs() - a[i] - rb);
+            best = best.max(t[i].abs() - a[i] - rb - slack);
             beyond_a[i] = (t[i].abs() - a[i]).max(0.0);
         }
         let mut beyond_b = Vector3::zeros();
         for j in 0..3 {
             let ra = a[0] * abs[(0, j)] + a[1] * abs[(1, j)] + a[2] * abs[(2, j)];
             let tj = t[0] * m[(0, j)] + t[1] * m[(1, j)] + t[2] * m[(2, j)];
-            best = best.max(tj.abs() - ra - b[j]);
+            best = best.max(tj.abs() - ra - b[j] - slack);
             beyond_b[j] = (tj.abs() - b[j]).max(0.0);
         }
         // Centre of B to box A, minus B's circumradius; centre of A to box B likewise.
-        best = best.max(centre_bound(&beyond_a, b));
-        best = best.max(centre_bound(&beyond_b, a));
+        best = best.max(centre_bound(&beyond_a, b) - slack);
+        best = best.max(centre_bound(&beyond_b, a) - slack);
         for i in 0..3 {
             let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
             for j in 0..3 {
@@ -160,7 +169,7 @@ impl BoxPair {
                 let ra = a[i1] * abs[(i2, j)] + a[i2] * abs[(i1, j)];
                 let rb = b[j1] * abs[(i, j2)] + b[j2] * abs[(i, j1)];
                 let tl = t[i2] * m[(i1, j)] - t[i1] * m[(i2, j)];
-                let gap = tl.abs() - ra - rb;
+                let gap = tl.abs() - ra - rb - slack;
                 if gap > best * len2.sqrt() {
                     best = gap / len2.sqrt();
                 }
@@ -193,6 +202,16 @@ impl BoxPair {
         }
         best.sqrt()
     }
+}
+
+/// The absolute slack added to every separating-axis comparison: `guard` times the sum of
+/// both boxes' half-widths and the centre offset's components (model units of A). It covers
+/// the rounding of stored box frames (f32 axes are orthonormal to about 1e-7, well inside
+/// the 1e-6 guard) whatever the boxes' shapes, at the cost of inflating each box by a
+/// millionth of the pair's size.
+#[inline(always)]
+fn frame_slack(guard: f64, a: &Vector3<f64>, b: &Vector3<f64>, t: &Vector3<f64>) -> f64 {
+    guard * (a.x + a.y + a.z + b.x + b.y + b.z + t.x.abs() + t.y.abs() + t.z.abs())
 }
 
 /// `|beyond| - |h|` when positive, else 0: the distance from a point to a box (given by how
