@@ -1,0 +1,476 @@
+//! Fuzz harness logic, shared by the cargo-fuzz targets in `fuzz/fuzz_targets/` and by the
+//! stable test `tests/fuzz_corpus.rs`, which replays the checked-in corpus through it.
+//!
+//! Depends only on `obbtree` and `std` (no libFuzzer), so it compiles in both places. Every
+//! function takes arbitrary bytes and must never panic, hang or abort on them: the library
+//! answers untrusted input with an error. The `assert!`s below only run on inputs the
+//! library accepted (a file that passed `verify`, a mesh that loaded and built), and check
+//! invariants that must then hold; a failure is a bug in the library.
+
+// Each fuzz target uses one of the three entry points.
+#![allow(dead_code)]
+
+use obbtree::build::{build, BuildError, BuildOptions};
+use obbtree::bv::BvKind;
+use obbtree::fit::FitMethod;
+use obbtree::format::{AlignedBytes, ObbtFile};
+use obbtree::mesh::TriMesh;
+use obbtree::query::{
+    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions,
+    CollideResult, DescentRule, DistanceOptions, DistanceResult, Pose, QueryContext, QueryError,
+    SpanResult, ToleranceResult,
+};
+use obbtree::real::Precision;
+use obbtree::tree::Encoding;
+
+/// Largest mesh the loader targets build (a build is O(n log n) with a convex hull per node).
+const MAX_BUILD_TRIANGLES: usize = 2_000;
+
+/// Size of the fixed `.obbt` header; the header CRC field is its last 4 bytes.
+const HEADER_SIZE: usize = 128;
+/// Offset of the header CRC field.
+const HEADER_CRC_OFFSET: usize = 124;
+/// Offset of the little-endian u16 section count in the header.
+const SECTION_COUNT_OFFSET: usize = 30;
+/// Size of one directory entry.
+const ENTRY_SIZE: usize = 40;
+/// Offsets inside a directory entry: offset (u64), length (u64), crc32 (u32).
+const ENTRY_OFFSET: usize = 8;
+const ENTRY_LENGTH: usize = 16;
+const ENTRY_CRC: usize = 36;
+
+/// Tolerance of the tolerance queries.
+const TOLERANCE: f64 = 0.5;
+
+/// Fuzz an `.obbt` image: open it, query it against itself (before `verify`, so queries on
+/// unverified files are exercised), verify it, and check invariants if it verifies. The same
+/// is done on a "re-sealed" copy whose header and section CRCs are recomputed, so that byte
+/// mutations get past the checksums and reach the section, query and verify code.
+pub fn obbt_reader(data: &[u8]) {
+    check_image(data);
+    if let Some(resealed) = reseal(data) {
+        if resealed != data {
+            check_image(&resealed);
+        }
+    }
+}
+
+/// Fuzz the OBJ loader: parse, and build and verify small meshes.
+pub fn obj_loader(data: &[u8]) {
+    if let Ok(mesh) = TriMesh::from_obj_bytes(data, "fuzz.obj") {
+        check_mesh(&mesh, data);
+    }
+}
+
+/// Fuzz the STL loader (binary and ASCII): parse, and build and verify small meshes.
+pub fn stl_loader(data: &[u8]) {
+    if let Ok(mesh) = TriMesh::from_stl_bytes(data, "fuzz.stl") {
+        check_mesh(&mesh, data);
+    }
+}
+
+/// A loaded mesh must satisfy `TriMesh`'s invariants; a small one must build into a file
+/// that verifies and answers queries soundly.
+fn check_mesh(mesh: &TriMesh, data: &[u8]) {
+    let vertex_count = mesh.vertices().len();
+    assert!(vertex_count >= 1, "a loaded mesh has no vertex");
+    assert!(!mesh.faces().is_empty(), "a loaded mesh has no face");
+    assert!(
+        mesh.faces()
+            .iter()
+            .flatten()
+            .all(|&i| (i as usize) < vertex_count),
+        "a loaded mesh has a vertex index out of range"
+    );
+    assert!(
+        mesh.vertices().iter().flatten().all(|c| c.is_finite()),
+        "a loaded mesh has a non-finite coordinate"
+    );
+    if mesh.faces().len() > MAX_BUILD_TRIANGLES {
+        return;
+    }
+    // The default options, and one more combination picked from the input's bytes so the
+    // other volumes, precisions, fits and the variable encoding get built too.
+    let pick = data.iter().fold(0usize, |h, &b| {
+        h.wrapping_mul(31).wrapping_add(usize::from(b))
+    });
+    let other = BuildOptions {
+        bv: [BvKind::Obb, BvKind::Aabb, BvKind::Sphere][pick % 3],
+        precision: [Precision::F32, Precision::F64][(pick / 3) % 2],
+        fit: [FitMethod::Hull, FitMethod::Triangles, FitMethod::Vertices][(pick / 6) % 3],
+        leaf_size: [1, 2, 4, 128][(pick / 18) % 4],
+    };
+    for options in [BuildOptions::default(), other] {
+        match build(mesh, &options, None) {
+            Ok(file) => {
+                if let Err(error) = file.verify() {
+                    panic!("a built file fails verify ({options:?}): {error}");
+                }
+                let before = Queries::run(&file);
+                check_verified(&file, &before);
+                // The built image, copied and opened as a reader would, is the same tree.
+                match ObbtFile::from_aligned(AlignedBytes::copy_from(file.bytes())) {
+                    Ok(reopened) => assert_eq!(
+                        reopened.info(),
+                        file.info(),
+                        "a reopened file reports other info"
+                    ),
+                    Err(error) => panic!("a built file does not open ({options:?}): {error}"),
+                }
+            }
+            // Coordinates beyond the f32 range are refused for f32 files, by design.
+            Err(BuildError::CoordinateOverflow { .. }) if options.precision == Precision::F32 => {}
+            Err(error) => panic!(
+                "a loaded mesh of {} triangles does not build ({options:?}): {error}",
+                mesh.faces().len()
+            ),
+        }
+    }
+}
+
+/// Opens, queries and verifies one image.
+fn check_image(data: &[u8]) {
+    let Ok(file) = ObbtFile::from_aligned(AlignedBytes::copy_from(data)) else {
+        return;
+    };
+    let info = file.info();
+    let _ = format!("{info:?} {:?}", file.sections());
+    // Queries before verify: an error or an answer, never a panic or a hang.
+    let before = Queries::run(&file);
+    if file.verify().is_ok() {
+        check_verified(&file, &before);
+    }
+}
+
+/// The fixed non-identity pose of B in the posed queries: a rotation (exact 3-4-5
+/// cosines and sines about z then x) and a small translation.
+fn posed() -> Option<Pose> {
+    Pose::from_row_major(&[
+        0.6, -0.48, 0.64, //
+        0.8, 0.36, -0.48, //
+        0.0, 0.8, 0.6, //
+        0.25, -0.125, 0.0625,
+    ])
+    .ok()
+}
+
+/// The answers of the queries run before `verify`: the file against itself, A at the
+/// identity and B at [`posed`].
+struct Queries {
+    collide: Option<Result<CollideResult, QueryError>>,
+    first: Option<Result<CollideResult, QueryError>>,
+    distance: Option<Result<DistanceResult, QueryError>>,
+    tolerance: Option<Result<ToleranceResult, QueryError>>,
+    span: Option<Result<SpanResult, QueryError>>,
+}
+
+impl Queries {
+    fn run(file: &ObbtFile) -> Queries {
+        let Some(pose_b) = posed() else {
+            return Queries {
+                collide: None,
+                first: None,
+                distance: None,
+                tolerance: None,
+                span: None,
+            };
+        };
+        let id = Pose::identity();
+        let mut cx = QueryContext::new();
+        let all = CollideOptions::default();
+        let first = CollideOptions {
+            first_contact: true,
+            ..CollideOptions::default()
+        };
+        let rule = DescentRule::default();
+        Queries {
+            collide: Some(collide_files(file, &id, file, &pose_b, &all, &mut cx)),
+            first: Some(collide_files(file, &id, file, &pose_b, &first, &mut cx)),
+            distance: Some(distance_files(
+                file,
+                &id,
+                file,
+                &pose_b,
+                &DistanceOptions::default(),
+                &mut cx,
+            )),
+            tolerance: Some(within_tolerance_files(
+                file, &id, file, &pose_b, TOLERANCE, rule, &mut cx,
+            )),
+            span: Some(span_files(file, &id, file, &pose_b, rule, &mut cx)),
+        }
+    }
+}
+
+/// Unwraps a query answer on a verified file, where an error is a bug.
+fn ok<'a, T>(what: &str, result: Option<&'a Result<T, QueryError>>) -> Option<&'a T> {
+    match result {
+        Some(Ok(value)) => Some(value),
+        Some(Err(error)) => panic!("{what} on a verified file failed: {error}"),
+        None => None,
+    }
+}
+
+/// Invariants of a file that passed `verify`; `before` holds the posed queries run on it
+/// before it was verified.
+fn check_verified(file: &ObbtFile, before: &Queries) {
+    let info = file.info();
+    let triangles = info.triangles;
+    let binary = info.encoding == Encoding::Binary;
+    // Largest coordinate magnitude, for the tolerances of the floating-point comparisons.
+    let scale = info
+        .bounds_min
+        .iter()
+        .chain(info.bounds_max.iter())
+        .fold(1.0f64, |m, c| m.max(c.abs()));
+    let slack = 1e-9 * scale;
+    let diagonal = (0..3)
+        .map(|k| {
+            let e = info.bounds_max[k] - info.bounds_min[k];
+            e * e
+        })
+        .sum::<f64>()
+        .sqrt();
+    let mut cx = QueryContext::new();
+    let id = Pose::identity();
+    let rule = DescentRule::default();
+
+    // The file against itself at the same pose: every triangle touches itself.
+    match collide_files(file, &id, file, &id, &CollideOptions::default(), &mut cx) {
+        Ok(hit) => {
+            assert!(
+                hit.colliding,
+                "a verified file does not collide with itself"
+            );
+            for t in 0..triangles {
+                assert!(
+                    hit.pairs.binary_search(&(t, t)).is_ok(),
+                    "self-collision misses triangle {t} touching itself"
+                );
+            }
+            check_collide_result(&hit, triangles, binary, "self-collision");
+        }
+        Err(error) => panic!("self-collision on a verified file failed: {error}"),
+    }
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
+    match collide_files(file, &id, file, &id, &first, &mut cx) {
+        Ok(hit) => {
+            assert!(hit.colliding, "first contact: no self-collision");
+            assert_eq!(hit.pairs.len(), 1, "first contact returned several pairs");
+            check_collide_result(&hit, triangles, false, "first-contact self-collision");
+        }
+        Err(error) => panic!("first-contact self-collision on a verified file failed: {error}"),
+    }
+    match distance_files(file, &id, file, &id, &DistanceOptions::default(), &mut cx) {
+        Ok(d) => {
+            assert!(
+                d.distance == 0.0,
+                "self-distance is {} (triangles {} and {}), not 0",
+                d.distance,
+                d.tri_a,
+                d.tri_b
+            );
+            assert!(
+                d.tri_a < triangles && d.tri_b < triangles,
+                "self-distance ids"
+            );
+        }
+        Err(error) => panic!("self-distance on a verified file failed: {error}"),
+    }
+    match within_tolerance_files(file, &id, file, &id, TOLERANCE, rule, &mut cx) {
+        Ok(w) => assert!(
+            w.closer,
+            "a verified file is not within tolerance of itself"
+        ),
+        Err(error) => panic!("self-tolerance on a verified file failed: {error}"),
+    }
+    match span_files(file, &id, file, &id, rule, &mut cx) {
+        Ok(s) => {
+            assert!(s.span >= 0.0, "self-span is {}", s.span);
+            assert!(
+                s.span <= diagonal * (1.0 + 1e-12) + 1e-300,
+                "self-span {} exceeds the bounds' diagonal {diagonal}",
+                s.span
+            );
+        }
+        Err(error) => panic!("self-span on a verified file failed: {error}"),
+    }
+
+    // The queries run before verify, now on a verified file: all must have answered.
+    let all = ok("collide", before.collide.as_ref());
+    if let Some(all) = all {
+        check_collide_result(all, triangles, binary, "posed collision");
+    }
+    if let Some(first) = ok("first contact", before.first.as_ref()) {
+        check_collide_result(first, triangles, false, "posed first contact");
+        if let Some(all) = all {
+            assert_eq!(
+                first.colliding, all.colliding,
+                "first contact and all contacts disagree"
+            );
+            if let Some(pair) = first.pairs.first() {
+                assert!(
+                    all.pairs.binary_search(pair).is_ok(),
+                    "the first contact {pair:?} is not among all contacts"
+                );
+            }
+        }
+    }
+    let distance = ok("distance", before.distance.as_ref());
+    if let Some(d) = distance {
+        assert!(d.distance >= 0.0, "posed distance is {}", d.distance);
+        assert!(
+            d.tri_a < triangles && d.tri_b < triangles,
+            "posed distance ids"
+        );
+        if let Some(all) = all {
+            if all.colliding {
+                assert!(
+                    d.distance <= slack,
+                    "the posed copies collide but their distance is {}",
+                    d.distance
+                );
+            }
+        }
+        let gap = (d.point_a - d.point_b).norm();
+        if d.distance.is_finite() && gap.is_finite() {
+            assert!(
+                (gap - d.distance).abs() <= slack,
+                "the distance points are {gap} apart, the distance is {}",
+                d.distance
+            );
+        }
+    }
+    if let Some(w) = ok("tolerance", before.tolerance.as_ref()) {
+        if let Some(witness) = &w.witness {
+            assert!(w.closer, "a tolerance witness without `closer`");
+            assert!(
+                witness.distance < TOLERANCE,
+                "a tolerance witness at {}",
+                witness.distance
+            );
+        } else {
+            assert!(!w.closer, "`closer` without a witness");
+        }
+        if let Some(d) = distance {
+            if d.distance < TOLERANCE - slack {
+                assert!(
+                    w.closer,
+                    "distance {} but not within {TOLERANCE}",
+                    d.distance
+                );
+            }
+            if d.distance > TOLERANCE + slack {
+                assert!(!w.closer, "distance {} but within {TOLERANCE}", d.distance);
+            }
+            if let Some(witness) = &w.witness {
+                assert!(
+                    witness.distance >= d.distance - slack,
+                    "a tolerance witness at {} is closer than the distance {}",
+                    witness.distance,
+                    d.distance
+                );
+            }
+        }
+    }
+    if let Some(s) = ok("span", before.span.as_ref()) {
+        assert!(s.span >= 0.0, "posed span is {}", s.span);
+        assert!(s.tri_a < triangles && s.tri_b < triangles, "posed span ids");
+        if let Some(d) = distance {
+            assert!(
+                s.span >= d.distance - slack,
+                "the span {} is less than the distance {}",
+                s.span,
+                d.distance
+            );
+        }
+    }
+}
+
+/// Pair ids in range, sorted and distinct; statistics consistent.
+fn check_collide_result(hit: &CollideResult, triangles: u32, complete_binary: bool, what: &str) {
+    assert_eq!(hit.colliding, !hit.pairs.is_empty(), "{what}: `colliding`");
+    assert!(
+        hit.pairs
+            .iter()
+            .all(|&(a, b)| a < triangles && b < triangles),
+        "{what}: a pair id out of range"
+    );
+    assert!(
+        hit.pairs.windows(2).all(|w| w[0] < w[1]),
+        "{what}: pairs not sorted and distinct"
+    );
+    let s = hit.stats;
+    assert_eq!(
+        s.nodes_visited,
+        s.bv_disjoint + s.bv_overlap,
+        "{what}: every visited pair is either pruned or not ({s:?})"
+    );
+    if complete_binary {
+        assert_eq!(
+            s.identity_value(),
+            1,
+            "{what}: 1 = D - I + 2S + 2K fails ({s:?})"
+        );
+    }
+}
+
+/// A copy of `data` with every in-bounds section CRC and then the header CRC recomputed,
+/// or `None` if `data` is shorter than the header.
+fn reseal(data: &[u8]) -> Option<Vec<u8>> {
+    if data.len() < HEADER_SIZE {
+        return None;
+    }
+    let mut out = data.to_vec();
+    let count = usize::from(u16::from_le_bytes([
+        *data.get(SECTION_COUNT_OFFSET)?,
+        *data.get(SECTION_COUNT_OFFSET + 1)?,
+    ]));
+    let directory_end = HEADER_SIZE.checked_add(count.checked_mul(ENTRY_SIZE)?)?;
+    for i in 0..count {
+        let entry = HEADER_SIZE + i * ENTRY_SIZE;
+        let (Some(offset), Some(length)) = (
+            read_u64(data, entry + ENTRY_OFFSET),
+            read_u64(data, entry + ENTRY_LENGTH),
+        ) else {
+            break;
+        };
+        let section = usize::try_from(offset).ok().and_then(|start| {
+            let end = start.checked_add(usize::try_from(length).ok()?)?;
+            data.get(start..end)
+        });
+        if let (Some(section), Some(field)) = (
+            section,
+            out.get_mut(entry + ENTRY_CRC..entry + ENTRY_CRC + 4),
+        ) {
+            field.copy_from_slice(&crc32(&[section]).to_le_bytes());
+        }
+    }
+    let directory = out.get(HEADER_SIZE..directory_end.min(out.len()))?;
+    let crc = crc32(&[out.get(..HEADER_CRC_OFFSET)?, directory]);
+    out.get_mut(HEADER_CRC_OFFSET..HEADER_SIZE)?
+        .copy_from_slice(&crc.to_le_bytes());
+    Some(out)
+}
+
+/// The little-endian u64 at `at`, if in bounds.
+fn read_u64(data: &[u8], at: usize) -> Option<u64> {
+    let bytes: [u8; 8] = data.get(at..at.checked_add(8)?)?.try_into().ok()?;
+    Some(u64::from_le_bytes(bytes))
+}
+
+/// CRC-32 (IEEE 802.3, reflected 0xEDB88320, as zlib and crc32fast) of the concatenation of
+/// `chunks`; bitwise, without a table.
+fn crc32(chunks: &[&[u8]]) -> u32 {
+    let mut crc = !0u32;
+    for &byte in chunks.iter().flat_map(|c| c.iter()) {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+        }
+    }
+    !crc
+}

@@ -1,0 +1,60 @@
+//! Replays the fuzz corpus on stable Rust: every file of `fuzz/corpus/<target>/` (the
+//! checked-in seeds) and of `fuzz/regressions/<target>/` (inputs that once crashed a target,
+//! kept after the fix) goes through the same harness function the cargo-fuzz target runs.
+//! See `fuzz/README.md`.
+
+#[path = "../fuzz/harness.rs"]
+mod harness;
+
+use std::path::{Path, PathBuf};
+
+/// The regular files of `dir` (skipping dot files), sorted; empty if `dir` does not exist.
+fn inputs(dir: &Path) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.is_file())
+        .filter(|path| {
+            path.file_name()
+                .and_then(|name| name.to_str())
+                .is_some_and(|name| !name.starts_with('.'))
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// Feeds the seed corpus (which must not be empty) and the regressions of `target` to `run`.
+fn replay(target: &str, run: fn(&[u8])) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz");
+    let corpus = inputs(&root.join("corpus").join(target));
+    assert!(
+        !corpus.is_empty(),
+        "fuzz/corpus/{target}/ holds no seed input"
+    );
+    let regressions = inputs(&root.join("regressions").join(target));
+    for path in corpus.iter().chain(regressions.iter()) {
+        let data =
+            std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+        // Name the input if the harness panics on it.
+        eprintln!("{target}: {}", path.display());
+        run(&data);
+    }
+}
+
+#[test]
+fn obbt_reader_corpus() {
+    replay("obbt_reader", harness::obbt_reader);
+}
+
+#[test]
+fn obj_loader_corpus() {
+    replay("obj_loader", harness::obj_loader);
+}
+
+#[test]
+fn stl_loader_corpus() {
+    replay("stl_loader", harness::stl_loader);
+}
