@@ -1030,44 +1030,24 @@ fn distances_beyond_the_f64_range_are_infinite_not_errors() {
     let mut context = QueryContext::new();
     for options in common::all_options() {
         let cube = built(&common::cube(1.0), &options);
-        let overflow = shifted(-1.7e308, 1.7e308, 0.0);
-        let d = distance_files(
-            &cube,
-            &Pose::identity(),
-            &cube,
-            &overflow,
-            &DistanceOptions::default(),
-            &mut context,
-        )
-        .expect("an answer");
-        assert_eq!(d.distance, f64::INFINITY, "{options:?}");
-        let far = shifted(1e300, 0.0, 0.0);
-        let d = distance_files(
-            &cube,
-            &Pose::identity(),
-            &cube,
-            &far,
-            &DistanceOptions::default(),
-            &mut context,
-        )
-        .expect("an answer");
-        assert_eq!(d.distance, 1e300, "{options:?}");
+        let mut distance_to = |pose_b: &Pose| {
+            distance_files(
+                &cube,
+                &Pose::identity(),
+                &cube,
+                pose_b,
+                &DistanceOptions::default(),
+                &mut context,
+            )
+            .expect("an answer")
+            .distance
+        };
+        let overflow = distance_to(&shifted(-1.7e308, 1.7e308, 0.0));
+        assert_eq!(overflow, f64::INFINITY, "{options:?}");
+        assert_eq!(distance_to(&shifted(1e300, 0.0, 0.0)), 1e300, "{options:?}");
         // Far apart along a diagonal (a thousand sizes): the exact distance of the corners.
-        let diagonal = shifted(1e3, 1e3, 1e3);
-        let d = distance_files(
-            &cube,
-            &Pose::identity(),
-            &cube,
-            &diagonal,
-            &DistanceOptions::default(),
-            &mut context,
-        )
-        .expect("an answer");
+        let diagonal = distance_to(&shifted(1e3, 1e3, 1e3));
         let corners = 3f64.sqrt() * (1e3 - 2.0);
-        assert!(
-            (d.distance - corners).abs() < 1e-9,
-            "{options:?}: {}",
-            d.distance
-        );
+        assert!((diagonal - corners).abs() < 1e-9, "{options:?}: {diagonal}");
     }
 }
