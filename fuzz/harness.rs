@@ -1,7 +1,8 @@
 //! Fuzz harness logic, shared by the cargo-fuzz targets in `fuzz/fuzz_targets/` and by the
 //! stable test `tests/fuzz_corpus.rs`, which replays the checked-in corpus through it.
 //!
-//! Depends only on `obbtree` and `std` (no libFuzzer), so it compiles in both places. Every
+//! Depends only on `obbtree`, `crc32fast` and the re-sealing of `tests/common/seal.rs`, which
+//! the mutation suites share (no libFuzzer), so it compiles in both places. Every
 //! function takes arbitrary bytes and must never panic, hang or abort on them: the library
 //! answers untrusted input with an error. The `assert!`s below only run on inputs the
 //! library accepted (a file that passed `verify`, a mesh that loaded and built), and check
@@ -9,6 +10,9 @@
 
 // Each fuzz target uses one of the three entry points.
 #![allow(dead_code)]
+
+#[path = "../tests/common/seal.rs"]
+mod seal;
 
 use obbtree::build::{build, BuildError, BuildOptions};
 use obbtree::bv::BvKind;
@@ -26,19 +30,6 @@ use obbtree::tree::Encoding;
 /// Largest mesh the loader targets build (a build is O(n log n) with a convex hull per node).
 const MAX_BUILD_TRIANGLES: usize = 2_000;
 
-/// Size of the fixed `.obbt` header; the header CRC field is its last 4 bytes.
-const HEADER_SIZE: usize = 128;
-/// Offset of the header CRC field.
-const HEADER_CRC_OFFSET: usize = 124;
-/// Offset of the little-endian u16 section count in the header.
-const SECTION_COUNT_OFFSET: usize = 30;
-/// Size of one directory entry.
-const ENTRY_SIZE: usize = 40;
-/// Offsets inside a directory entry: offset (u64), length (u64), crc32 (u32).
-const ENTRY_OFFSET: usize = 8;
-const ENTRY_LENGTH: usize = 16;
-const ENTRY_CRC: usize = 36;
-
 /// Tolerance of the tolerance queries.
 const TOLERANCE: f64 = 0.5;
 
@@ -48,10 +39,10 @@ const TOLERANCE: f64 = 0.5;
 /// mutations get past the checksums and reach the section, query and verify code.
 pub fn obbt_reader(data: &[u8]) {
     check_image(data);
-    if let Some(resealed) = reseal(data) {
-        if resealed != data {
-            check_image(&resealed);
-        }
+    let mut sealed = data.to_vec();
+    seal::seal(&mut sealed);
+    if sealed != data {
+        check_image(&sealed);
     }
 }
 
@@ -416,61 +407,4 @@ fn check_collide_result(hit: &CollideResult, triangles: u32, complete_binary: bo
             "{what}: 1 = D - I + 2S + 2K fails ({s:?})"
         );
     }
-}
-
-/// A copy of `data` with every in-bounds section CRC and then the header CRC recomputed,
-/// or `None` if `data` is shorter than the header.
-fn reseal(data: &[u8]) -> Option<Vec<u8>> {
-    if data.len() < HEADER_SIZE {
-        return None;
-    }
-    let mut out = data.to_vec();
-    let count = usize::from(u16::from_le_bytes([
-        *data.get(SECTION_COUNT_OFFSET)?,
-        *data.get(SECTION_COUNT_OFFSET + 1)?,
-    ]));
-    let directory_end = HEADER_SIZE.checked_add(count.checked_mul(ENTRY_SIZE)?)?;
-    for i in 0..count {
-        let entry = HEADER_SIZE + i * ENTRY_SIZE;
-        let (Some(offset), Some(length)) = (
-            read_u64(data, entry + ENTRY_OFFSET),
-            read_u64(data, entry + ENTRY_LENGTH),
-        ) else {
-            break;
-        };
-        let section = usize::try_from(offset).ok().and_then(|start| {
-            let end = start.checked_add(usize::try_from(length).ok()?)?;
-            data.get(start..end)
-        });
-        if let (Some(section), Some(field)) = (
-            section,
-            out.get_mut(entry + ENTRY_CRC..entry + ENTRY_CRC + 4),
-        ) {
-            field.copy_from_slice(&crc32(&[section]).to_le_bytes());
-        }
-    }
-    let directory = out.get(HEADER_SIZE..directory_end.min(out.len()))?;
-    let crc = crc32(&[out.get(..HEADER_CRC_OFFSET)?, directory]);
-    out.get_mut(HEADER_CRC_OFFSET..HEADER_SIZE)?
-        .copy_from_slice(&crc.to_le_bytes());
-    Some(out)
-}
-
-/// The little-endian u64 at `at`, if in bounds.
-fn read_u64(data: &[u8], at: usize) -> Option<u64> {
-    let bytes: [u8; 8] = data.get(at..at.checked_add(8)?)?.try_into().ok()?;
-    Some(u64::from_le_bytes(bytes))
-}
-
-/// CRC-32 (IEEE 802.3, reflected 0xEDB88320, as zlib and crc32fast) of the concatenation of
-/// `chunks`; bitwise, without a table.
-fn crc32(chunks: &[&[u8]]) -> u32 {
-    let mut crc = !0u32;
-    for &byte in chunks.iter().flat_map(|c| c.iter()) {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
-        }
-    }
-    !crc
 }

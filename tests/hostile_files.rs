@@ -17,9 +17,10 @@
 mod common;
 
 use common::mutate::{
-    entry_offset, exercise, extreme_values, read_uint, seal, write_uint, Outcome, Poses, Rng,
-    Tally, ENTRY_FIELDS, HEADER_FIELDS,
+    entry_offset, exercise, extreme_values, read_uint, write_uint, Outcome, Poses, Rng, Tally,
+    ENTRY_FIELDS, HEADER_FIELDS,
 };
+use common::seal::seal;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
 use obbtree::format::{AlignedBytes, FormatError, ObbtFile};

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod mutate;
+pub mod seal;
 
 use obbtree::mesh::TriMesh;
 

@@ -8,9 +8,7 @@
 
 use obbtree::bv::pair::Transform;
 use obbtree::bv::BoundingVolume;
-use obbtree::format::layout::{
-    header_crc, ENTRY_SIZE, HEADER_CRC_OFFSET, HEADER_SIZE, MAX_SECTIONS,
-};
+use obbtree::format::layout::{ENTRY_SIZE, HEADER_SIZE};
 use obbtree::format::{AlignedBytes, ObbtFile, TreeVisitor};
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
@@ -132,42 +130,9 @@ pub fn extreme_values(width: usize, file_len: u64) -> Vec<u64> {
     values
 }
 
-/// The number of directory entries the header declares, if the header is there.
-fn section_count(bytes: &[u8]) -> Option<usize> {
-    (bytes.len() >= HEADER_SIZE).then(|| read_uint(bytes, 30, 2) as usize)
-}
-
 /// Byte offset of directory entry `index`.
 pub fn entry_offset(index: usize) -> usize {
     HEADER_SIZE + ENTRY_SIZE * index
-}
-
-/// Recomputes every checksum that can be recomputed: each section's CRC whose bytes are in
-/// bounds, then the header CRC. What remains wrong is then caught only by the structural
-/// checks, which is what these suites want to reach.
-pub fn seal(bytes: &mut [u8]) {
-    let Some(count) = section_count(bytes) else {
-        return;
-    };
-    let count = count.min(usize::from(MAX_SECTIONS));
-    for index in 0..count {
-        let e = entry_offset(index);
-        if e + ENTRY_SIZE > bytes.len() {
-            break;
-        }
-        let offset = read_uint(bytes, e + 8, 8);
-        let length = read_uint(bytes, e + 16, 8);
-        if let Some(end) = offset
-            .checked_add(length)
-            .filter(|&end| end <= bytes.len() as u64)
-        {
-            let crc = crc32fast::hash(&bytes[offset as usize..end as usize]);
-            write_uint(bytes, e + 36, 4, u64::from(crc));
-        }
-    }
-    let directory_end = entry_offset(count).min(bytes.len());
-    let crc = header_crc(&bytes[..HEADER_SIZE], &bytes[HEADER_SIZE..directory_end]);
-    write_uint(bytes, HEADER_CRC_OFFSET, 4, u64::from(crc));
 }
 
 /// Where an image was stopped, or that it answered.
