@@ -11,35 +11,23 @@ mod common;
 
 use nalgebra::{Rotation3, Vector3};
 use obbtree::build::build;
-use obbtree::bv::BoundingVolume;
-use obbtree::format::{ObbtFile, TreeVisitor};
+use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
 use obbtree::query::triangle::{triangle_distance, triangles_intersect, Triangle};
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
     DistanceOptions, Pose, QueryContext,
 };
-use obbtree::real::point_to_f64;
-use obbtree::tree::TreeView;
 use proptest::prelude::*;
 
 /// The stored triangles of a file, by input-mesh id, in its model frame.
-struct Triangles;
-impl TreeVisitor for Triangles {
-    type Output = Vec<Triangle>;
-    fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Vec<Triangle> {
-        let mut out = vec![[Vector3::zeros(); 3]; tree.faces().len()];
-        for (face, &id) in tree.source_ids().iter().enumerate() {
-            let t = tree.triangle(face as u32).unwrap();
-            out[id as usize] = t.map(Vector3::from);
-        }
-        let _ = point_to_f64::<B::Real>;
-        out
-    }
-}
-
 fn stored(file: &ObbtFile) -> Vec<Triangle> {
-    file.visit(Triangles).unwrap()
+    let faces = common::file_triangles(file);
+    let mut out = vec![[Vector3::zeros(); 3]; faces.len()];
+    for (id, t) in faces {
+        out[id as usize] = t.map(Vector3::from);
+    }
+    out
 }
 
 fn mesh_strategy() -> impl Strategy<Value = TriMesh> {

@@ -246,3 +246,21 @@ pub fn tree_f64(mesh: &TriMesh) -> obbtree::format::ObbtFile {
     };
     obbtree::build::build(mesh, &options, None).expect("builds")
 }
+
+/// The input-mesh id and model-frame corners of every face of a file, in face order; faces
+/// whose corners or id a damaged file does not hold are left out.
+pub fn file_triangles(file: &obbtree::format::ObbtFile) -> Vec<(u32, [[f64; 3]; 3])> {
+    struct Faces;
+    impl obbtree::format::TreeVisitor for Faces {
+        type Output = Vec<(u32, [[f64; 3]; 3])>;
+        fn visit<B: obbtree::bv::BoundingVolume>(
+            self,
+            tree: obbtree::tree::TreeView<'_, B>,
+        ) -> Self::Output {
+            (0..tree.faces().len() as u32)
+                .filter_map(|f| Some((tree.source_id(f)?, tree.triangle(f)?)))
+                .collect()
+        }
+    }
+    file.visit(Faces).expect("a view of the file's own type")
+}

@@ -7,14 +7,12 @@
 //! compare its collision answer with a brute force over the file's own triangles.
 
 use obbtree::bv::pair::Transform;
-use obbtree::bv::BoundingVolume;
 use obbtree::format::layout::{ENTRY_SIZE, HEADER_SIZE};
-use obbtree::format::{AlignedBytes, ObbtFile, TreeVisitor};
+use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
     DistanceOptions, Pose, QueryContext,
 };
-use obbtree::tree::TreeView;
 
 /// A seeded xorshift generator: the same seed gives the same mutations on every machine.
 pub struct Rng(u64);
@@ -275,20 +273,6 @@ pub fn exercise(bytes: &[u8], partner: &ObbtFile, poses: &Poses, check_answers: 
     outcome
 }
 
-/// The input-mesh id and model-frame corners of every face of a file.
-pub fn file_triangles(file: &ObbtFile) -> Vec<(u32, [[f64; 3]; 3])> {
-    struct Faces;
-    impl TreeVisitor for Faces {
-        type Output = Vec<(u32, [[f64; 3]; 3])>;
-        fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            (0..tree.faces().len() as u32)
-                .filter_map(|f| Some((tree.source_id(f)?, tree.triangle(f)?)))
-                .collect()
-        }
-    }
-    file.visit(Faces).expect("a view of the file's own type")
-}
-
 /// Every contacting pair of two posed files by testing all pairs, B mapped into A's frame
 /// exactly as the queries map it; sorted input-mesh ids.
 pub fn brute_force_pairs(
@@ -299,11 +283,11 @@ pub fn brute_force_pairs(
 ) -> Vec<(u32, u32)> {
     let xf: Transform = Pose::relative(pose_a, pose_b);
     let to_vectors = |t: &[[f64; 3]; 3]| t.map(nalgebra::Vector3::from);
-    let ta: Vec<_> = file_triangles(a)
+    let ta: Vec<_> = super::file_triangles(a)
         .iter()
         .map(|(id, t)| (*id, to_vectors(t)))
         .collect();
-    let tb: Vec<_> = file_triangles(b)
+    let tb: Vec<_> = super::file_triangles(b)
         .iter()
         .map(|(id, t)| (*id, to_vectors(t).map(|p| xf.apply(&p))))
         .collect();
