@@ -4,6 +4,7 @@
 //! byte-order types (alignment 1), so they can be read from any offset on any host; the
 //! sections are read zero-copy as native types, which is why big-endian hosts are refused.
 
+use crate::real::Precision;
 use zerocopy::byteorder::little_endian::{F64, U16, U32, U64};
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 
@@ -161,6 +162,12 @@ impl SectionKind {
             SectionKind::Nodes => "nodes",
         }
     }
+}
+
+/// The stride of one vertex record in bytes: three scalars of `precision` (whose tag is a
+/// scalar's size in bytes), 12 or 24.
+pub(crate) fn vertex_stride(precision: Precision) -> u32 {
+    u32::from(precision.tag()).saturating_mul(3)
 }
 
 /// Rounds `n` up to the next multiple of [`SECTION_ALIGN`], or `None` on overflow.

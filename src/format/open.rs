@@ -3,8 +3,8 @@
 use super::aligned::AlignedBytes;
 use super::error::{FormatError, OpenError, VerifyError};
 use super::layout::{
-    align_up, header_crc, Header, SectionEntry, SectionKind, ENTRY_SIZE, FLAG_REQUIRED,
-    HEADER_SIZE, MAX_SECTIONS, SECTION_ALIGN, SIGNATURE, VERSION_MAJOR,
+    align_up, header_crc, vertex_stride, Header, SectionEntry, SectionKind, ENTRY_SIZE,
+    FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, SECTION_ALIGN, SIGNATURE, VERSION_MAJOR,
 };
 use crate::bv::{Aabb, BoundingVolume, BvKind, Node, Obb, Sphere};
 use crate::fit::FitMethod;
@@ -429,10 +429,7 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
 
     let expected = |kind: SectionKind| -> (u64, u32) {
         match kind {
-            SectionKind::Vertices => (
-                u64::from(header.vertices.get()),
-                u32::from(precision.tag()).saturating_mul(3),
-            ),
+            SectionKind::Vertices => (u64::from(header.vertices.get()), vertex_stride(precision)),
             SectionKind::Faces => (u64::from(header.triangles.get()), 12),
             SectionKind::SourceIds => (u64::from(header.triangles.get()), 4),
             SectionKind::Nodes => (

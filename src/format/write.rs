@@ -2,8 +2,8 @@
 
 use super::aligned::AlignedBytes;
 use super::layout::{
-    align_up, header_crc, Header, SectionEntry, SectionKind, ENTRY_SIZE, FLAG_REQUIRED,
-    HEADER_SIZE, SIGNATURE, VERSION_MAJOR, VERSION_MINOR,
+    align_up, header_crc, vertex_stride, Header, SectionEntry, SectionKind, ENTRY_SIZE,
+    FLAG_REQUIRED, HEADER_SIZE, SIGNATURE, VERSION_MAJOR, VERSION_MINOR,
 };
 use super::open::ObbtFile;
 use crate::build::{BuildError, BuildOptions, BuiltTree};
@@ -45,7 +45,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         (
             SectionKind::Vertices,
             tree.vertices.len() as u64,
-            u32::from(<B::Real as Real>::PRECISION.tag()).saturating_mul(3),
+            vertex_stride(<B::Real as Real>::PRECISION),
         ),
         (SectionKind::Faces, tree.faces.len() as u64, 12),
         (SectionKind::SourceIds, tree.source_ids.len() as u64, 4),
