@@ -4,6 +4,9 @@
 //!   0.8, §5.3.1), the small one at x with a seeded random rotation; `first/<x>`: first
 //!   contact. Contacts and D, I, S, K are printed once per x.
 //! - `concentric`: exact distance between spheres of radii 1 and 1.05 (gap 0.05).
+//! - `far/<offset>`: exact distance and `rel_err` 0.01 between two bundled cows (about 1 unit
+//!   across), B turned and moved 1e3 … 1e9 along a diagonal, OBB f32 (the default) and AABB
+//!   f32: the work must not grow with the offset. Triangle tests are printed per offset.
 //! - `parry/*`: parry3d 0.31 on the same meshes and poses: boolean intersection
 //!   (`query::intersection_test`), all pairs (`Bvh::leaf_pairs` with a posed AABB check,
 //!   then parry's exact triangle test), and distance (`query::distance`).
@@ -152,5 +155,52 @@ fn concentric_spheres(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, sliding_spheres, concentric_spheres);
+fn far_apart(c: &mut Criterion) {
+    let cow = common::cow();
+    let mut context = QueryContext::new();
+    let mut group = c.benchmark_group("far");
+    println!("\ntwo cows far apart, triangle tests of exact distance / rel_err 0.01:");
+    for bv in [obbtree::bv::BvKind::Obb, obbtree::bv::BvKind::Aabb] {
+        let options = obbtree::build::BuildOptions {
+            bv,
+            ..Default::default()
+        };
+        let file = obbtree::build::build(&cow, &options, None).expect("builds");
+        for offset in [1e3, 1e5, 1e6, 1e9] {
+            let direction = nalgebra::Vector3::new(1.0, -1.0, 1.0).normalize();
+            let pose = Pose::new(common::seeded_rotation(3), direction * offset).expect("pose");
+            let a = Pose::identity();
+            let exact = DistanceOptions::default();
+            let rel = DistanceOptions {
+                rel_err: 0.01,
+                ..DistanceOptions::default()
+            };
+            let tests = |o: &DistanceOptions, context: &mut QueryContext| {
+                let s = distance_files(&file, &a, &file, &pose, o, context)
+                    .expect("query")
+                    .stats;
+                s.tri_separated + s.tri_contact
+            };
+            println!(
+                "  {} {offset:e}: {} / {}",
+                bv.name(),
+                tests(&exact, &mut context),
+                tests(&rel, &mut context)
+            );
+            for (name, o) in [("exact", &exact), ("rel-err-0.01", &rel)] {
+                let id = BenchmarkId::new(format!("{}-{name}", bv.name()), offset);
+                group.bench_with_input(id, o, |bench, o| {
+                    bench.iter(|| {
+                        distance_files(&file, &a, &file, &pose, o, &mut context)
+                            .expect("query")
+                            .distance
+                    })
+                });
+            }
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, sliding_spheres, concentric_spheres, far_apart);
 criterion_main!(benches);

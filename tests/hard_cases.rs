@@ -244,6 +244,7 @@ fn guard_case_boxes_overlap_and_only_the_guarded_test_says_so() {
         t: Vector3::from(GUARD_T),
         ha: Vector3::from(GUARD_HA),
         hb: Vector3::from(GUARD_HB),
+        frame_error: 0.0,
     };
     // Ground truth: A's centre, expressed in B's box coordinates (solving exactly with the
     // inverse, not the transpose, since the axes are not quite orthonormal), is inside B.
@@ -317,10 +318,15 @@ fn guard_case_without_the_guard_loses_real_contacts() {
                 &mut context,
             )
             .unwrap();
-            assert!(
-                !unguarded.colliding,
-                "{options:?}: without the guard the root test wrongly prunes every contact"
-            );
+            // f32 frames are orthonormal only within 1e-6, and the slack that covers it
+            // (4e-6 x the centre offset) is larger than this case's noise: only f64 files
+            // show what the guard alone protects.
+            if precision == Precision::F64 {
+                assert!(
+                    !unguarded.colliding,
+                    "{options:?}: without the guard the root test wrongly prunes every contact"
+                );
+            }
         }
     }
 }

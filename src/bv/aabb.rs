@@ -1,6 +1,6 @@
 //! Axis-aligned bounding box in the model frame.
 
-use super::pair::{box_pair_methods, BoxPair, Transform};
+use super::pair::{box_pair_methods, BoxPair, PairSetup, Transform};
 use super::{all_finite, face_vertices, listed_vertices, BoundingVolume, BvDefect, BvKind};
 use crate::arr3;
 use crate::real::{point_to_f64, Real};
@@ -31,12 +31,14 @@ impl<R: Real> Aabb<R> {
         ((lo + hi) * 0.5, (hi - lo) * 0.5)
     }
 
+    /// The pair in box A's frame. Model axes are exactly orthonormal, so both setups are
+    /// the same and the slack is rounding only.
     #[inline]
-    fn pair_with(&self, other: &Self, xf: &Transform) -> BoxPair {
+    fn pair_with(&self, other: &Self, xf: &Transform, _setup: PairSetup) -> BoxPair {
         let (ca, ha) = self.center_half();
         let (cb, hb) = other.center_half();
         let identity = Matrix3::identity();
-        BoxPair::new(&identity, &ca, ha, &identity, &cb, hb, xf)
+        BoxPair::new(&identity, &ca, ha, &identity, &cb, hb, xf, 0.0)
     }
 
     fn half_f64(&self) -> [f64; 3] {

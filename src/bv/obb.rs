@@ -1,6 +1,6 @@
 //! Oriented bounding box (dissertation §3.2).
 
-use super::pair::{box_pair_methods, BoxPair, Transform};
+use super::pair::{box_pair_methods, BoxPair, PairSetup, Transform, SAT_GUARD};
 use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
     BvKind,
@@ -46,17 +46,39 @@ impl<R: Real> Obb<R> {
         )
     }
 
+    /// The pair in box A's frame.
+    ///
+    /// Stored frames are orthonormal only within the precision's axis tolerance δ (1e-6 for
+    /// f32, 1e-10 for f64), and projecting the centre offset `t` through them errs by about
+    /// `4δ|t|`, which [`BoxPair::slack`] covers. For an overlap test that is nothing: only
+    /// boxes within about their own size of each other can overlap. For a distance bound
+    /// between boxes far apart relative to their size (models 1e6 apart) it would swamp the
+    /// bound, so the metric setup then (past [`FAR`]) re-orthonormalises both frames in f64
+    /// and widens the half-widths to cover the move, leaving only rounding in the slack.
     #[inline]
-    fn pair_with(&self, other: &Self, xf: &Transform) -> BoxPair {
-        BoxPair::new(
-            &self.axes_matrix(),
-            &Vector3::from(self.center_f64()),
+    fn pair_with(&self, other: &Self, xf: &Transform, setup: PairSetup) -> BoxPair {
+        let tol = axis_tolerance(R::PRECISION);
+        let ca = Vector3::from(self.center_f64());
+        let cb = Vector3::from(other.center_f64());
+        let (ha, hb) = (
             Vector3::from(self.half_f64()),
-            &other.axes_matrix(),
-            &Vector3::from(other.center_f64()),
             Vector3::from(other.half_f64()),
-            xf,
-        )
+        );
+        let offset = xf.apply(&cb) - ca;
+        let (axes_a, axes_b) = (self.axes_matrix(), other.axes_matrix());
+        let frame_term = 4.0 * tol * offset.abs().sum();
+        if setup == PairSetup::Metric && frame_term > FAR * SAT_GUARD * (ha.sum() + hb.sum()) {
+            return BoxPair::from_offset(
+                &orthonormal_rows(&axes_a),
+                widen(ha, tol),
+                &orthonormal_rows(&axes_b),
+                widen(hb, tol),
+                &offset,
+                &xf.rotation,
+                0.0,
+            );
+        }
+        BoxPair::from_offset(&axes_a, ha, &axes_b, hb, &offset, &xf.rotation, tol)
     }
 
     /// The axes widened to f64, one per row.
@@ -119,6 +141,33 @@ impl<R: Real> Obb<R> {
             half,
         }
     }
+}
+
+/// How many times the guard's share of the slack the frames' share may reach before a
+/// distance bound re-orthonormalises the frames: below it the bound is loosened by at most
+/// `FAR · 1e-6` of the boxes' size, which prunes the same; above it (f32 boxes more than
+/// about 16 of their sizes apart) the frames' error would grow with the offset.
+const FAR: f64 = 64.0;
+
+/// The rows of `axes` made orthonormal in f64 (Gram–Schmidt, the third row as the cross
+/// product of the first two: a box is symmetric, so the sign of an axis does not matter).
+/// Degenerate or non-finite rows (a damaged, unverified file) give NaN entries, which the
+/// pair tests read as "may overlap" and "no bound".
+fn orthonormal_rows(axes: &Matrix3<f64>) -> Matrix3<f64> {
+    let (r0, r1) = (axes.row(0).transpose(), axes.row(1).transpose());
+    let q0 = r0 / r0.norm();
+    let v1 = r1 - q0 * q0.dot(&r1);
+    let q1 = v1 / v1.norm();
+    let q2 = q0.cross(&q1);
+    Matrix3::from_rows(&[q0.transpose(), q1.transpose(), q2.transpose()])
+}
+
+/// Half-widths `h` of a box whose frame is orthonormal within `tol`, widened so the box
+/// along the re-orthonormalised frame ([`orthonormal_rows`]) contains it: each new axis is
+/// within about `3 tol` of the stored one, which moves a point `x` of the box (|x| at most
+/// Σh) by at most `3 tol Σh` along it; `4 tol` covers second-order terms.
+fn widen(h: Vector3<f64>, tol: f64) -> Vector3<f64> {
+    h.add_scalar(4.0 * tol * h.sum())
 }
 
 pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {

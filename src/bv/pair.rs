@@ -35,6 +35,10 @@ impl Transform {
 /// could report a separation; the guard makes the test conservative there.
 pub const SAT_GUARD: f64 = 1e-6;
 
+/// Relative error of the centre offset's projections that f64 rounding alone can cause
+/// (a few roundings of products and sums of `|t|`-sized terms), with a wide margin.
+pub const OFFSET_ROUNDING: f64 = 64.0 * f64::EPSILON;
+
 /// Two boxes in the frame of box A: A is centred at the origin with axes along x, y, z and
 /// half-widths `ha`; B is centred at `t` with axes the columns of `m` and half-widths `hb`.
 #[derive(Clone, Copy, Debug)]
@@ -47,12 +51,19 @@ pub struct BoxPair {
     pub ha: Vector3<f64>,
     /// B's half-widths.
     pub hb: Vector3<f64>,
+    /// How far the two box frames may be from orthonormal: the largest `|a_i·a_j − δ_ij|`
+    /// of either frame (0 for exact frames). Expressing B's centre in A's box frame treats
+    /// A's axes as orthonormal, so every projection of `t` other than on A's own axes is
+    /// off by up to about `4 · frame_error · |t|`; see [`BoxPair::slack`].
+    pub frame_error: f64,
 }
 
 impl BoxPair {
     /// Expresses box B (axes as rows `b_axes`, centre `cb`, in model B's frame) in box A's
-    /// frame (axes as rows `a_axes`, centre `ca`, in model A's frame).
+    /// frame (axes as rows `a_axes`, centre `ca`, in model A's frame). `frame_error` bounds
+    /// the frames' departure from orthonormality (see [`BoxPair::frame_error`]).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         a_axes: &Matrix3<f64>,
         ca: &Vector3<f64>,
@@ -61,25 +72,61 @@ impl BoxPair {
         cb: &Vector3<f64>,
         hb: Vector3<f64>,
         xf: &Transform,
+        frame_error: f64,
     ) -> BoxPair {
-        let a_r = a_axes * xf.rotation;
+        let offset = xf.apply(cb) - ca;
+        BoxPair::from_offset(a_axes, ha, b_axes, hb, &offset, &xf.rotation, frame_error)
+    }
+
+    /// As [`BoxPair::new`], given the centre offset `offset = xf(cb) − ca` (model A's
+    /// frame) and the rotation of `xf`.
+    #[inline]
+    pub fn from_offset(
+        a_axes: &Matrix3<f64>,
+        ha: Vector3<f64>,
+        b_axes: &Matrix3<f64>,
+        hb: Vector3<f64>,
+        offset: &Vector3<f64>,
+        rotation: &Matrix3<f64>,
+        frame_error: f64,
+    ) -> BoxPair {
+        let a_r = a_axes * rotation;
         BoxPair {
             m: a_r * b_axes.transpose(),
-            t: a_axes * (xf.apply(cb) - ca),
+            t: a_axes * offset,
             ha,
             hb,
+            frame_error,
         }
+    }
+
+    /// The absolute slack added to every separating-axis comparison (model units of A):
+    ///
+    /// - `guard` times the sum of both boxes' half-widths: a box frame off orthonormal by
+    ///   δ misplaces the box's own extent by about δ times its size (f32 frames: δ ≈ 2e-7,
+    ///   within the 1e-6 guard), which the rotation guard alone covers only through the
+    ///   other box's half-widths (found by fuzzing: a thin box touching another was reported
+    ///   disjoint);
+    /// - `(4 · frame_error + OFFSET_ROUNDING)` times `|t|₁`: the error of projecting the
+    ///   centre offset through frames that are not exactly orthonormal, and of rounding.
+    ///
+    /// The second term once used the guard too, which for models 1e6 apart inflated every
+    /// box by the size of the model and made distance queries visit nearly every leaf pair;
+    /// it is now as small as the frames allow, and frames far apart are re-orthonormalised
+    /// (see [`crate::bv::Obb`]) so that it stays at the rounding level.
+    #[inline(always)]
+    pub fn slack(&self, guard: f64) -> f64 {
+        let (a, b, t) = (&self.ha, &self.hb, &self.t);
+        guard * (a.x + a.y + a.z + b.x + b.y + b.z)
+            + (4.0 * self.frame_error + OFFSET_ROUNDING) * (t.x.abs() + t.y.abs() + t.z.abs())
     }
 
     /// Whether the boxes are disjoint, by the 15 separating axes of §4.3, with `guard` added
     /// to the absolute rotation entries ([`SAT_GUARD`] in queries; 0 only to demonstrate why
     /// the guard is needed). Conservative: overlapping boxes are never reported disjoint.
     ///
-    /// Every comparison also gets the slack [`frame_slack`]: box axes stored in f32 are
-    /// orthonormal only to about 1e-7, an error that scales with the boxes' extents and the
-    /// distance between their centres. The rotation guard covers it only through the other
-    /// box's half-widths, so a thin box (a single triangle, a sliver) touching another could
-    /// be reported disjoint and a contact lost (found by fuzzing).
+    /// Every comparison also gets the [`BoxPair::slack`] of frames that are not exactly
+    /// orthonormal (f32 axes) and of rounding.
     #[inline]
     // why: 3x3 matrix / 3-vector entries indexed by axis numbers in 0..3 (loop counters and
     // their cyclic successors); the hottest test of every query, kept in the book's form.
@@ -87,7 +134,7 @@ impl BoxPair {
     pub fn disjoint(&self, guard: f64) -> bool {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs().add_scalar(guard);
-        let slack = frame_slack(guard, a, b, t);
+        let slack = self.slack(guard);
         // A's face axes.
         for i in 0..3 {
             let rb = b[0] * abs[(i, 0)] + b[1] * abs[(i, 1)] + b[2] * abs[(i, 2)];
@@ -139,7 +186,7 @@ impl BoxPair {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs();
         // Each term is lowered by the frame slack, as `disjoint` raises its radii by it.
-        let slack = frame_slack(SAT_GUARD, a, b, t);
+        let slack = self.slack(SAT_GUARD);
         let mut best = 0.0f64;
         let mut beyond_a = Vector3::zeros();
         for i in 0..3 {
@@ -157,6 +204,8 @@ impl BoxPair {
         // Centre of B to box A, minus B's circumradius; centre of A to box B likewise.
         best = best.max(centre_bound(&beyond_a, b) - slack);
         best = best.max(centre_bound(&beyond_b, a) - slack);
+        // The line through the centres, the separating direction of boxes far apart.
+        best = best.max(centre_line_gap(t, m, a, b) - slack);
         for i in 0..3 {
             let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
             for j in 0..3 {
@@ -181,7 +230,8 @@ impl BoxPair {
     /// The largest distance between a point of A and a point of B, exactly: the maximum of
     /// a convex function over two boxes is attained at corners, and for each corner `p` of A
     /// the farthest point of B is the corner opposite `p` along each of B's axes, at squared
-    /// distance `|p - t|^2 + 2 Σ_j hb_j |(p - t)·b_j| + |hb|^2`.
+    /// distance `|p - t|^2 + 2 Σ_j hb_j |(p - t)·b_j| + |hb|^2`; plus the slack of
+    /// [`BoxPair::frame_error`] (none for exact frames but rounding).
     #[inline]
     pub fn max_distance(&self) -> f64 {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
@@ -200,18 +250,28 @@ impl BoxPair {
                 + hb2;
             best = best.max(d2);
         }
-        best.sqrt()
+        // Raised by the frames' own slack (as `disjoint` raises its radii by the guard's):
+        // frames that are not exactly orthonormal could otherwise make this "upper" bound a
+        // little short.
+        best.sqrt() + self.slack(self.frame_error)
     }
 }
 
-/// The absolute slack added to every separating-axis comparison: `guard` times the sum of
-/// both boxes' half-widths and the centre offset's components (model units of A). It covers
-/// the rounding of stored box frames (f32 axes are orthonormal to about 1e-7, well inside
-/// the 1e-6 guard) whatever the boxes' shapes, at the cost of inflating each box by a
-/// millionth of the pair's size.
+/// The gap between the boxes' projections on the line through their centres: `|t|` less
+/// both boxes' support radii along `t / |t|`. For boxes far apart this is the distance up to
+/// how much the boxes bulge across the line (second order), where the other bounds are
+/// short by a box's circumradius (the centre bounds) or by the cosine between a face axis
+/// and the line (the axis gaps); thin boxes far apart (single triangles, the leaves of two
+/// distant models) are where it matters. 0 for coincident centres.
 #[inline(always)]
-fn frame_slack(guard: f64, a: &Vector3<f64>, b: &Vector3<f64>, t: &Vector3<f64>) -> f64 {
-    guard * (a.x + a.y + a.z + b.x + b.y + b.z + t.x.abs() + t.y.abs() + t.z.abs())
+fn centre_line_gap(t: &Vector3<f64>, m: &Matrix3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let length = t.norm();
+    if !(length > 0.0 && length.is_finite()) {
+        return 0.0;
+    }
+    let u = t / length;
+    let along_b = m.tr_mul(&u);
+    length - a.dot(&u.abs()) - b.dot(&along_b.abs())
 }
 
 /// `|beyond| - |h|` when positive, else 0: the distance from a point to a box (given by how
@@ -234,23 +294,38 @@ fn centre_bound(beyond: &Vector3<f64>, h: &Vector3<f64>) -> f64 {
     scale * (beyond / scale).norm() - r2.sqrt()
 }
 
+/// How a box pair is set up: [`Fast`](PairSetup::Fast) takes the stored frames as they are
+/// and covers their error with [`BoxPair::slack`] (right for overlap tests, where only
+/// boxes within about their own size of each other matter); [`Metric`](PairSetup::Metric)
+/// is for distance bounds, which must stay tight for boxes any distance apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PairSetup {
+    Fast,
+    Metric,
+}
+
 /// The pair tests and size measures shared by the two box volumes, written once: both types
-/// provide `pair_with(&self, &Self, &Transform) -> BoxPair` and `half_f64(&self) -> [f64; 3]`.
+/// provide `pair_with(&self, &Self, &Transform, PairSetup) -> BoxPair` and
+/// `half_f64(&self) -> [f64; 3]`.
 macro_rules! box_pair_methods {
     () => {
         #[inline]
         fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool {
-            !self.pair_with(other, xf).disjoint(guard)
+            !self
+                .pair_with(other, xf, $crate::bv::pair::PairSetup::Fast)
+                .disjoint(guard)
         }
 
         #[inline]
         fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
-            self.pair_with(other, xf).distance_lower_bound()
+            self.pair_with(other, xf, $crate::bv::pair::PairSetup::Metric)
+                .distance_lower_bound()
         }
 
         #[inline]
         fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
-            self.pair_with(other, xf).max_distance()
+            self.pair_with(other, xf, $crate::bv::pair::PairSetup::Metric)
+                .max_distance()
         }
 
         fn diameter(&self) -> f64 {

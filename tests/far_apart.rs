@@ -1,0 +1,190 @@
+//! Models far apart cost what models near each other cost.
+//!
+//! Two copies of the bundled cow (about 1 unit across), B translated by 1e3 … 1e9. The box
+//! tests once carried a slack proportional to the centre offset (a millionth of it), which
+//! at 1e6 is as large as the cow: every lower bound collapsed and an exact distance measured
+//! 25 million of the 33.7 million triangle pairs (5 s) where 1e3 measured 491. The work is
+//! deterministic, so the test asserts triangle-test counts, not times.
+
+mod common;
+
+use nalgebra::Vector3;
+use obbtree::build::{build, BuildOptions};
+use obbtree::bv::BvKind;
+use obbtree::format::ObbtFile;
+use obbtree::query::triangle::{triangle_distance, Triangle};
+use obbtree::query::{
+    collide_files, distance_files, within_tolerance_files, CollideOptions, DescentRule,
+    DistanceOptions, Pose, QueryContext, Stats,
+};
+use obbtree::real::Precision;
+
+const OFFSETS: [f64; 5] = [1e3, 1e5, 1e6, 1e7, 1e9];
+
+fn triangle_tests(s: &Stats) -> u64 {
+    s.tri_separated + s.tri_contact
+}
+
+/// B turned a little (so no box axis lines up with the offset) and moved `offset` along
+/// `direction`.
+fn pose_b(offset: f64, direction: Vector3<f64>) -> Pose {
+    Pose::new(common::seeded_rotation(3), direction.normalize() * offset).unwrap()
+}
+
+struct Work {
+    exact: u64,
+    approximate: u64,
+    tolerance_no: u64,
+    tolerance_yes: u64,
+}
+
+fn work(file: &ObbtFile, pose: &Pose, distance: f64, context: &mut QueryContext) -> Work {
+    let a = Pose::identity();
+    let exact = distance_files(file, &a, file, pose, &DistanceOptions::default(), context)
+        .unwrap()
+        .stats;
+    let rel = DistanceOptions {
+        rel_err: 0.01,
+        ..DistanceOptions::default()
+    };
+    let approximate = distance_files(file, &a, file, pose, &rel, context)
+        .unwrap()
+        .stats;
+    let rule = DescentRule::default();
+    // Just short of the distance: the answer is "no", every candidate must be ruled out.
+    let no =
+        within_tolerance_files(file, &a, file, pose, distance * 0.999_999, rule, context).unwrap();
+    assert!(!no.closer);
+    // Just past it: "yes", found by descending towards the closest pair.
+    let yes =
+        within_tolerance_files(file, &a, file, pose, distance * 1.000_001, rule, context).unwrap();
+    assert!(yes.closer);
+    Work {
+        exact: triangle_tests(&exact),
+        approximate: triangle_tests(&approximate),
+        tolerance_no: triangle_tests(&no.stats),
+        tolerance_yes: triangle_tests(&yes.stats),
+    }
+}
+
+#[test]
+fn distance_work_does_not_grow_with_the_offset() {
+    let cow = common::cow();
+    let mut context = QueryContext::new();
+    for bv in [BvKind::Obb, BvKind::Aabb] {
+        for precision in Precision::ALL {
+            let options = BuildOptions {
+                bv,
+                precision,
+                ..BuildOptions::default()
+            };
+            let file = build(&cow, &options, None).unwrap();
+            for direction in [Vector3::x(), Vector3::new(1.0, -1.0, 1.0)] {
+                let mut baseline: Option<Work> = None;
+                for offset in OFFSETS {
+                    let pose = pose_b(offset, direction);
+                    let a = Pose::identity();
+                    let exact = DistanceOptions::default();
+                    let d = distance_files(&file, &a, &file, &pose, &exact, &mut context)
+                        .unwrap()
+                        .distance;
+                    // The cow is about 1 unit across: the gap is the offset less about that.
+                    assert!(d > offset - 2.0 && d < offset, "{offset}: distance {d}");
+                    let w = work(&file, &pose, d, &mut context);
+                    let label = format!("{bv:?} {precision:?} along {direction:?} at {offset:e}");
+                    let base = baseline.get_or_insert(Work { ..w });
+                    for (what, now, then) in [
+                        ("exact", w.exact, base.exact),
+                        ("rel_err 0.01", w.approximate, base.approximate),
+                        ("tolerance (no)", w.tolerance_no, base.tolerance_no),
+                        ("tolerance (yes)", w.tolerance_yes, base.tolerance_yes),
+                    ] {
+                        assert!(
+                            now <= 2 * then.max(1),
+                            "{label}: {what} made {now} triangle tests, {then} at 1e3"
+                        );
+                    }
+                    // Far apart, collision is decided at the roots.
+                    let hit = collide_files(
+                        &file,
+                        &a,
+                        &file,
+                        &pose,
+                        &CollideOptions::default(),
+                        &mut context,
+                    )
+                    .unwrap();
+                    assert!(!hit.colliding);
+                    assert_eq!(hit.stats.nodes_visited, 1, "{label}");
+                }
+            }
+        }
+    }
+}
+
+/// Far apart, the exact distance is still exact. Along x, only triangles of A reaching
+/// within 0.05 of its largest x and of B within 0.05 of its smallest can hold the closest
+/// pair (every other pair is farther apart in x alone than the answer), so a brute force
+/// over those two slabs is the reference.
+#[test]
+fn far_distances_stay_exact() {
+    let cow = common::cow();
+    let mut context = QueryContext::new();
+    for precision in Precision::ALL {
+        let options = BuildOptions {
+            precision,
+            ..BuildOptions::default()
+        };
+        let file = build(&cow, &options, None).unwrap();
+        let stored = common::file_triangles(&file);
+        let max_x = stored
+            .iter()
+            .flat_map(|(_, t)| t.iter().map(|p| p[0]))
+            .fold(f64::MIN, f64::max);
+        let min_x = stored
+            .iter()
+            .flat_map(|(_, t)| t.iter().map(|p| p[0]))
+            .fold(f64::MAX, f64::min);
+        let right: Vec<_> = stored
+            .iter()
+            .filter(|(_, t)| t.iter().any(|p| p[0] > max_x - 0.05))
+            .collect();
+        let left: Vec<_> = stored
+            .iter()
+            .filter(|(_, t)| t.iter().any(|p| p[0] < min_x + 0.05))
+            .collect();
+        for offset in OFFSETS {
+            let pose = Pose::translation(offset, 0.0, 0.0);
+            let r = distance_files(
+                &file,
+                &Pose::identity(),
+                &file,
+                &pose,
+                &DistanceOptions::default(),
+                &mut context,
+            )
+            .unwrap();
+            // B mapped into A's frame as the query maps it.
+            let xf = Pose::relative(&Pose::identity(), &pose);
+            let brute = right
+                .iter()
+                .flat_map(|(_, ta)| {
+                    let ta: Triangle = ta.map(Vector3::from);
+                    left.iter().map(move |(_, tb)| {
+                        let tb: Triangle = tb.map(|p| xf.apply(&Vector3::from(p)));
+                        triangle_distance(&ta, &tb).distance
+                    })
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                brute < offset - (max_x - min_x) + 1e-3,
+                "the slabs hold the answer"
+            );
+            assert!(
+                (r.distance - brute).abs() <= 8.0 * f64::EPSILON * offset,
+                "{precision:?} at {offset:e}: {} vs brute force {brute}",
+                r.distance
+            );
+        }
+    }
+}
