@@ -1,5 +1,7 @@
 //! The command-line contract: exit statuses, one-line errors, `info --json` fields.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -402,5 +404,246 @@ fn malformed_poses_and_mismatched_trees_are_exit_1() {
     let aabb = dir.join("aabb.obbt");
     build(&aabb, &["--bv", "aabb"]);
     assert_bad_input(&obbtree(&["span", f, aabb.to_str().unwrap()]), "differ");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+// ---------------------------------------------------------------------------------------
+// What the command writes: never its input, never a foreign file unless --force; closed
+// pipes; interrupts.
+
+#[test]
+fn build_never_overwrites_its_own_input() {
+    let dir = scratch("victim");
+    let victim = dir.join("victim.obj");
+    std::fs::copy(cow(), &victim).unwrap();
+    let original = std::fs::read(&victim).unwrap();
+    let symlink = dir.join("link.obbt");
+    std::os::unix::fs::symlink(&victim, &symlink).unwrap();
+    let hardlink = dir.join("hard.obbt");
+    std::fs::hard_link(&victim, &hardlink).unwrap();
+    let dotted = dir.join(".").join("victim.obj");
+    for output in [&victim, &dotted, &symlink, &hardlink] {
+        for force in [false, true] {
+            let mut args = vec!["build", victim.to_str().unwrap(), "-o"];
+            args.push(output.to_str().unwrap());
+            if force {
+                args.push("--force");
+            }
+            assert_bad_input(&obbtree(&args), "refusing to overwrite");
+            assert_eq!(std::fs::read(&victim).unwrap(), original, "{output:?}");
+        }
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn build_replaces_a_file_that_is_not_obbt_only_with_force() {
+    let dir = scratch("foreign");
+    let notes = dir.join("notes.txt");
+    std::fs::write(&notes, "my notes\n").unwrap();
+    let args = ["build", &cow(), "-o", notes.to_str().unwrap(), "--quiet"];
+    assert_bad_input(&obbtree(&args), "use --force");
+    assert_eq!(std::fs::read(&notes).unwrap(), b"my notes\n");
+    // An existing .obbt file is an earlier build: replaced without asking.
+    let tree = dir.join("cow.obbt");
+    build(&tree, &["--precision", "f64"]);
+    build(&tree, &[]);
+    let o = obbtree(&["info", "--json", tree.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["precision"], "f32");
+    let o = obbtree(&[&args[..], &["--force"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(obbtree(&["verify", notes.to_str().unwrap()])
+        .status
+        .success());
+    // A directory is never replaced.
+    assert_bad_input(
+        &obbtree(&["build", &cow(), "-o", dir.to_str().unwrap(), "--force"]),
+        "is a directory",
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn unreadable_tree_inputs_get_the_readers_error() {
+    let dir = scratch("unreadable");
+    let empty = dir.join("empty.obbt");
+    std::fs::write(&empty, b"").unwrap();
+    let e = empty.to_str().unwrap();
+    assert_bad_input(&obbtree(&["info", e]), "truncated: 0 bytes");
+    // Named .obbt, so read as a tree even though its signature is missing.
+    assert_bad_input(&obbtree(&["collide", &cow(), e]), "truncated: 0 bytes");
+    assert_bad_input(
+        &obbtree(&["info", dir.to_str().unwrap()]),
+        "is a directory, not a .obbt file",
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Runs `args`, reads `keep` lines of its standard output, closes the pipe, and returns
+/// the exit status and standard error.
+fn run_into_closed_pipe(args: &[&str], keep: usize) -> (Option<i32>, String) {
+    use std::io::{BufRead, Read};
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_obbtree"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut reader = std::io::BufReader::new(child.stdout.take().unwrap());
+    for _ in 0..keep {
+        let mut line = String::new();
+        reader.read_line(&mut line).unwrap();
+    }
+    drop(reader);
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (status.code(), err)
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    let dir = scratch("pipe");
+    let tree = dir.join("cow.obbt");
+    build(&tree, &[]);
+    let t = tree.to_str().unwrap();
+    let poses = dir.join("poses.txt");
+    let line = "1 0 0 0 1 0 0 0 1 0 0 0 1 0 0 0 1 0 0 0 1 0.2 0 0\n";
+    std::fs::write(&poses, line.repeat(2000)).unwrap();
+    let out = dir.join("demo");
+    for (args, keep) in [
+        // 78,422 contact lines after the summary.
+        (vec!["collide", t, t, "--pairs"], 2),
+        (vec!["collide", t, t, "--poses", poses.to_str().unwrap()], 1),
+        (vec!["demo", "--out", out.to_str().unwrap()], 1),
+    ] {
+        let (code, err) = run_into_closed_pipe(&args, keep);
+        assert_eq!(code, Some(0), "{args:?}: {err}");
+        assert!(err.is_empty(), "{args:?}: {err}");
+    }
+    // The demo finished its work although nobody read what it printed.
+    for bv in ["obb", "aabb", "sphere"] {
+        let file = out.join(format!("cow-{bv}.obbt"));
+        assert!(obbtree(&["verify", file.to_str().unwrap()])
+            .status
+            .success());
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The files of `dir` whose names contain `.tmp`.
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect()
+}
+
+/// Writes a lat/long sphere of `2 * slices * (stacks - 1)` triangles as OBJ.
+fn write_sphere_obj(path: &Path, stacks: u32, slices: u32) {
+    use std::fmt::Write as _;
+    let mesh = common::uv_sphere(1.0, stacks, slices);
+    let mut text = String::new();
+    for v in mesh.vertices() {
+        writeln!(text, "v {} {} {}", v[0], v[1], v[2]).unwrap();
+    }
+    for f in mesh.faces() {
+        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+fn interrupt(child: &std::process::Child, signal: &str) {
+    let pid = child.id().to_string();
+    assert!(Command::new("kill")
+        .args([signal, &pid])
+        .status()
+        .unwrap()
+        .success());
+}
+
+/// Ctrl-C while the output is being written (the temporary file exists) leaves neither
+/// the output nor the temporary file; at any earlier point, nothing at all.
+#[test]
+fn an_interrupted_build_leaves_nothing_behind() {
+    let dir = scratch("interrupt");
+    let mesh = dir.join("sphere.obj");
+    write_sphere_obj(&mesh, 300, 600); // 358,800 triangles, a 54 MB file
+    let out = dir.join("sphere.obbt");
+    let build_args = [
+        "build",
+        mesh.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--fit",
+        "vertices",
+        "--quiet",
+    ];
+    // While building: nothing is on disk yet, nothing is left.
+    for signal in ["-INT", "-TERM"] {
+        let child = Command::new(env!("CARGO_BIN_EXE_obbtree"))
+            .args(build_args)
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(150));
+        interrupt(&child, signal);
+        let status = child.wait_with_output().unwrap().status;
+        assert_eq!(status.code(), Some(130), "{signal}");
+        assert!(!out.exists());
+        assert_eq!(temporaries(&dir), Vec::<String>::new());
+    }
+    // While writing: caught the moment the temporary file appears. If the write wins the
+    // race (it finished before the signal arrived), try again.
+    let mut caught = false;
+    for _ in 0..5 {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_obbtree"))
+            .args(build_args)
+            .spawn()
+            .unwrap();
+        while temporaries(&dir).is_empty() && child.try_wait().unwrap().is_none() {
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        if child.try_wait().unwrap().is_none() {
+            interrupt(&child, "-INT");
+        }
+        let code = child.wait().unwrap().code();
+        assert_eq!(temporaries(&dir), Vec::<String>::new());
+        if code == Some(130) {
+            assert!(!out.exists(), "an interrupted build left its output");
+            caught = true;
+            break;
+        }
+        assert_eq!(code, Some(0));
+        std::fs::remove_file(&out).unwrap();
+    }
+    assert!(caught, "never interrupted while writing");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A build killed outright (SIGKILL, a power cut) cannot clean up; the next build of the
+/// same output removes what it left.
+#[test]
+fn a_build_removes_temporaries_of_a_killed_build() {
+    let dir = scratch("stale");
+    let out = dir.join("cow.obbt");
+    // A process id no process has: past the largest Linux allows by default.
+    let stale = dir.join(".cow.obbt.4194305.0.tmp");
+    std::fs::write(&stale, b"partial").unwrap();
+    // Not ours to touch: another name, and a live process's temporary.
+    let other = dir.join(".other.obbt.4194305.0.tmp");
+    std::fs::write(&other, b"partial").unwrap();
+    let live = dir.join(format!(".cow.obbt.{}.0.tmp", std::process::id()));
+    std::fs::write(&live, b"partial").unwrap();
+    build(&out, &[]);
+    assert!(!stale.exists());
+    assert!(other.exists() && live.exists());
     std::fs::remove_dir_all(dir).unwrap();
 }

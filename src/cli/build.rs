@@ -1,12 +1,13 @@
 //! `obbtree build`: mesh file in, `.obbt` file out.
 
+use super::files::check_output;
 use super::{human_bytes, Failure};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
-use obbtree::format::ObbtFile;
+use obbtree::format::{remove_stale_temporaries, ObbtFile};
 use obbtree::mesh::TriMesh;
 use obbtree::real::Precision;
 use std::io::IsTerminal;
@@ -18,7 +19,11 @@ use std::time::{Duration, Instant};
 ///
 /// Loads an OBJ or STL triangle soup (format from the extension, or sniffed), fits a
 /// bounding volume to every node top-down, and writes vertices, faces and nodes into one
-/// aligned, checksummed file, atomically (a crash never leaves a partial file).
+/// aligned, checksummed file, atomically (a crash never leaves a partial file; Ctrl-C
+/// leaves neither the output nor a temporary file).
+///
+/// OUT is never the input mesh, and an existing OUT that is not an .obbt file is replaced
+/// only with --force.
 ///
 /// Example: obbtree build bunny.obj -o bunny.obbt
 #[derive(Args, Debug)]
@@ -33,6 +38,10 @@ pub struct BuildArgs {
     /// No progress bar and no summary line.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Replace OUT even if it exists and is not an .obbt file. The input mesh itself is
+    /// never overwritten, with or without --force.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Options that shape a tree, shared by every command that builds one.
@@ -167,9 +176,13 @@ pub fn load_mesh(path: &Path) -> Result<TriMesh, Failure> {
 pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     let started = Instant::now();
     let options = args.tree.options();
+    // Checked before the work, so a refused output costs nothing.
+    check_output(&args.output, &[&args.mesh], args.force)?;
     let mesh = load_mesh(&args.mesh)?;
     let label = args.mesh.display().to_string();
     let file = build_with_progress(&mesh, &options, &label, args.quiet)?;
+    // Temporaries of an earlier build of this output that was killed outright.
+    let _ = remove_stale_temporaries(&args.output);
     file.write_atomic(&args.output)
         .map_err(|e| Failure(format!("{}: cannot write: {e}", args.output.display())))?;
     if !args.quiet {

@@ -1,6 +1,8 @@
 //! `obbtree demo`: the main job on the bundled asset, end to end.
 
 use super::build::build_with_progress;
+use super::files::check_output;
+use super::print::out;
 use super::{human_bytes, Failure};
 use clap::Args;
 use nalgebra::{Rotation3, Vector3};
@@ -48,13 +50,13 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
 
 fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
     let mesh = TriMesh::from_obj_bytes(COW_OBJ, "cow.obj")?;
-    println!(
+    out!(
         "obbtree demo: bundled mesh cow.obj, {} triangles, {} vertices ({} zero-area)",
         mesh.faces().len(),
         mesh.vertices().len(),
         mesh.degenerate_triangle_count()
-    );
-    println!("writing into {}", dir.display());
+    )?;
+    out!("writing into {}", dir.display())?;
     for bv in BvKind::ALL {
         let options = BuildOptions {
             bv,
@@ -64,6 +66,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
         let built = build_with_progress(&mesh, &options, "cow.obj", true)?;
         let build_ms = started.elapsed().as_secs_f64() * 1e3;
         let path = dir.join(format!("cow-{}.obbt", bv.name()));
+        check_output(&path, &[], false)?;
         built
             .write_atomic(&path)
             .map_err(|e| Failure(format!("{}: {e}", path.display())))?;
@@ -77,7 +80,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
         let verify_ms = started.elapsed().as_secs_f64() * 1e3;
         let same = opened.bytes() == built.bytes();
         let info = opened.info();
-        println!(
+        out!(
             "  {:<6} {:>9}  {} nodes, depth {:>2}  built {:>6.1} ms, opened {:>6.1} us, verified {:>5.1} ms, file == memory: {}",
             bv.name(),
             human_bytes(info.file_bytes),
@@ -87,7 +90,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
             open_us,
             verify_ms,
             if same { "yes" } else { "NO" }
-        );
+        )?;
         if !same {
             return Err(Failure(format!(
                 "{}: the file read back differs from the tree built",
@@ -96,7 +99,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
         }
     }
     run_queries(&dir.join("cow-obb.obbt"))?;
-    println!("inspect a file with: obbtree info <file>   (run with --out DIR to keep the files)");
+    out!("inspect a file with: obbtree info <file>   (run with --out DIR to keep the files)")?;
     Ok(())
 }
 
@@ -106,7 +109,7 @@ fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
     let extent = cow.info().bounds_max[0] - cow.info().bounds_min[0];
     let mut context = QueryContext::new();
     let a = Pose::identity();
-    println!("queries between two cows (A fixed, B turned 30 degrees about z and moved along x; lengths in model units):");
+    out!("queries between two cows (A fixed, B turned 30 degrees about z and moved along x; lengths in model units):")?;
     for shift in [0.25, 0.6, 1.5] {
         let rotation = *Rotation3::from_euler_angles(0.0, 0.0, 30f64.to_radians()).matrix();
         let b = Pose::new(rotation, Vector3::new(shift * extent, 0.0, 0.0))?;
@@ -133,14 +136,14 @@ fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
         let started = Instant::now();
         let far = span_files(&cow, &a, &cow, &b, DescentRule::default(), &mut context)?;
         let span_us = started.elapsed().as_secs_f64() * 1e6;
-        println!(
+        out!(
             "  B at x = {:.3}: {} contacts ({collide_us:.0} us; first contact {} in {first_us:.0} us), distance {:.4} ({distance_us:.0} us), span {:.4} ({span_us:.0} us)",
             shift * extent,
             all.pairs.len(),
             if any.colliding { "found" } else { "none" },
             gap.distance,
             far.span,
-        );
+        )?;
     }
     Ok(())
 }

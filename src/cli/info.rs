@@ -1,8 +1,10 @@
 //! `obbtree info`: what a file holds, from its header alone.
 
+use super::print::out;
 use super::{human_bytes, Failure};
 use clap::Args;
 use obbtree::format::{Info, ObbtFile};
+use obbtree::real::Precision;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -23,9 +25,9 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
     let file = ObbtFile::open(&args.file)?;
     let info = file.info();
     if args.json {
-        println!("{}", to_json(&info));
+        out!("{}", to_json(&info))?;
     } else {
-        print_text(&args.file.display().to_string(), &info);
+        print_text(&args.file.display().to_string(), &info)?;
     }
     Ok(())
 }
@@ -58,45 +60,68 @@ pub fn to_json(info: &Info) -> serde_json::Value {
     })
 }
 
-fn print_text(name: &str, info: &Info) {
-    println!(
+fn print_text(name: &str, info: &Info) -> Result<(), Failure> {
+    out!(
         "{name}: .obbt version {}.{}",
-        info.version.0, info.version.1
-    );
-    println!(
+        info.version.0,
+        info.version.1
+    )?;
+    out!(
         "  triangles      {} ({} zero-area)",
-        info.triangles, info.degenerate_triangles
-    );
-    println!("  vertices       {}", info.vertices);
-    println!(
-        "  nodes          {} ({} leaves, depth {}, up to {} faces per leaf)",
-        info.nodes, info.leaves, info.depth, info.max_leaf_faces
-    );
-    println!(
+        info.triangles,
+        info.degenerate_triangles
+    )?;
+    out!("  vertices       {}", info.vertices)?;
+    let per_leaf = match info.max_leaf_faces {
+        1 => "1 face per leaf".to_string(),
+        n => format!("up to {n} faces per leaf"),
+    };
+    out!(
+        "  nodes          {} ({} leaves, depth {}, {per_leaf})",
+        info.nodes,
+        info.leaves,
+        info.depth
+    )?;
+    out!(
         "  built with     --bv {} --precision {} --fit {} --leaf-size {} ({} encoding)",
         info.bv.name(),
         info.precision.name(),
         info.fit.name(),
         info.leaf_size,
         info.encoding.name()
-    );
-    println!(
-        "  bounds         {:?} .. {:?}",
-        info.bounds_min, info.bounds_max
-    );
-    println!(
+    )?;
+    out!(
+        "  bounds         {} .. {}",
+        stored_point(info, info.bounds_min),
+        stored_point(info, info.bounds_max)
+    )?;
+    out!(
         "  size           {} ({:.1} bytes per triangle)",
         human_bytes(info.file_bytes),
         info.file_bytes as f64 / f64::from(info.triangles.max(1))
-    );
+    )?;
     for s in &info.sections {
-        println!(
+        out!(
             "  section {:<11} offset {:>10}  {:>10}  ({} x {} bytes)",
             s.name(),
             s.offset,
             human_bytes(s.length),
             s.count,
             s.stride
-        );
+        )?;
     }
+    Ok(())
+}
+
+/// A stored point as the shortest decimals that read back to the stored values: f32 files
+/// hold f32 coordinates, which widened to f64 would print with 17 meaningless digits.
+fn stored_point(info: &Info, p: [f64; 3]) -> String {
+    let shown: Vec<String> = p
+        .iter()
+        .map(|&v| match info.precision {
+            Precision::F32 => format!("{}", v as f32),
+            Precision::F64 => format!("{v}"),
+        })
+        .collect();
+    format!("[{}]", shown.join(", "))
 }

@@ -3,7 +3,9 @@
 
 mod build;
 mod demo;
+mod files;
 mod info;
+mod print;
 mod query;
 mod verify;
 
@@ -51,6 +53,7 @@ impl<E: std::fmt::Display> From<E> for Failure {
 /// Parses the arguments, runs the command, and maps the outcome to an exit status.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    files::handle_interrupts();
     let outcome = match cli.command {
         Command::Build(args) => build::run(&args),
         Command::Info(args) => info::run(&args),

@@ -1,10 +1,11 @@
 //! `obbtree collide | distance | span`: queries between two posed models.
 
 use super::build::{build_with_progress, load_mesh, TreeArgs};
+use super::files::is_obbt;
+use super::print::{self, out};
 use super::Failure;
 use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
-use obbtree::format::layout::SIGNATURE;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
@@ -12,7 +13,6 @@ use obbtree::query::{
 };
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -134,28 +134,30 @@ pub struct SpanArgs {
     pub inputs: QueryInputs,
 }
 
-/// Opens a .obbt file, or loads and builds a mesh, matching `like` when given.
+/// Whether an input is to be read as a tree: it starts with the `.obbt` signature, or it
+/// is named `*.obbt` (so a damaged or empty one gets the reader's error, such as
+/// "truncated", not the mesh loader's "unknown mesh format").
+fn is_tree_input(path: &Path) -> bool {
+    is_obbt(path)
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("obbt"))
+}
+
+/// Opens a .obbt file, or loads and builds a mesh with `options`.
 fn open_input(path: &Path, options: &BuildOptions) -> Result<ObbtFile, Failure> {
-    if is_obbt(path) {
+    if is_tree_input(path) {
         return Ok(ObbtFile::open(path)?);
     }
     let mesh = load_mesh(path)?;
     build_with_progress(&mesh, options, &path.display().to_string(), false)
 }
 
-fn is_obbt(path: &Path) -> bool {
-    let mut head = [0u8; 8];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok()
-        && head == SIGNATURE
-}
-
 fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
     let mut options = inputs.tree.options();
     // A mesh paired with a tree file is built to match it, so the pair can be queried.
     for path in [&inputs.a, &inputs.b] {
-        if is_obbt(path) {
+        if is_tree_input(path) {
             let info = ObbtFile::open(path)?.info();
             options.bv = info.bv;
             options.precision = info.precision;
@@ -291,9 +293,9 @@ where
             let (a, b) = single_pose(inputs)?;
             let (value, text) = query(&a, &b, &mut QueryContext::new())?;
             if inputs.json {
-                println!("{value}");
+                out!("{value}")?;
             } else {
-                println!("{text}");
+                out!("{text}")?;
             }
         }
         Some(batch) => {
@@ -304,9 +306,12 @@ where
                 })
                 .collect();
             for (index, answer) in answers.into_iter().enumerate() {
+                if print::closed() {
+                    break;
+                }
                 let mut value = answer?;
                 insert(&mut value, "pose", json!(index));
-                println!("{value}");
+                out!("{value}")?;
             }
         }
     }

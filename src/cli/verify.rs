@@ -1,5 +1,6 @@
 //! `obbtree verify`: the full O(n) integrity check.
 
+use super::print::out;
 use super::Failure;
 use clap::Args;
 use obbtree::format::ObbtFile;
@@ -22,11 +23,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     file.verify()
         .map_err(|e| Failure(format!("{}: verify failed: {e}", args.file.display())))?;
     let info = file.info();
-    println!(
+    out!(
         "{}: ok ({} triangles, {} nodes)",
         args.file.display(),
         info.triangles,
         info.nodes
-    );
+    )?;
     Ok(())
 }

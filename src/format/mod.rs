@@ -24,4 +24,4 @@ pub use aligned::AlignedBytes;
 pub use error::{FormatError, OpenError, VerifyError};
 pub use open::{Info, ObbtFile, SectionInfo, TreeVisitor};
 pub(crate) use write::serialize;
-pub use write::write_atomic;
+pub use write::{abandon_writes, remove_stale_temporaries, write_atomic};

@@ -167,7 +167,20 @@ impl ObbtFile {
             source,
         };
         let file = std::fs::File::open(path).map_err(io)?;
-        let len = file.metadata().map_err(io)?.len();
+        let metadata = file.metadata().map_err(io)?;
+        if !metadata.is_file() {
+            // Mapping a directory fails with an obscure "No such device".
+            let what = if metadata.is_dir() {
+                "is a directory, not a .obbt file"
+            } else {
+                "is not a regular file"
+            };
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                what,
+            )));
+        }
+        let len = metadata.len();
         // Mapping an empty file fails on some systems; an empty buffer gets the clearer
         // "truncated" error from the header checks instead.
         let backing = if len == 0 {

@@ -12,7 +12,8 @@ use crate::real::{Precision, Real};
 use rayon::prelude::*;
 use std::io::Write;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 use zerocopy::IntoBytes;
 
 /// Number of sections the writer lays out: the four required ones.
@@ -221,30 +222,142 @@ fn put_real<R: Real>(x: R, out: &mut [u8]) {
     }
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed to
-/// disk, then renamed over `path`, then the directory flushed. On any error the temporary
-/// file is removed and `path` is untouched.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+/// Temporary files this process is writing right now, and whether writes were abandoned:
+/// the bookkeeping behind [`abandon_writes`].
+struct InFlight {
+    abandoned: bool,
+    paths: Vec<PathBuf>,
+}
+
+static IN_FLIGHT: Mutex<InFlight> = Mutex::new(InFlight {
+    abandoned: false,
+    paths: Vec::new(),
+});
+
+/// The registry, whatever a panicking holder left (its contents stay meaningful).
+fn in_flight() -> MutexGuard<'static, InFlight> {
+    IN_FLIGHT.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+fn interrupted() -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::Interrupted,
+        "the write was abandoned (interrupted)",
+    )
+}
+
+/// Removes every temporary file that [`write_atomic`] is writing in this process and makes
+/// all later and unfinished writes fail without touching their destination.
+///
+/// For a program about to exit on a signal (the `obbtree` command calls it from its Ctrl-C
+/// handler, then exits): no temporary file is left behind, and no destination is replaced
+/// after this returns. A write that had already renamed its file into place has finished
+/// and stays.
+pub fn abandon_writes() {
+    let mut flight = in_flight();
+    flight.abandoned = true;
+    for path in flight.paths.drain(..) {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
+/// The temporary name of a write to `path` by this process: `.NAME.PID.N.tmp` in the same
+/// directory (the one place the pattern is written; [`remove_stale_temporaries`] parses it).
+fn temporary_name(name: &str, pid: u32, unique: u64) -> String {
+    format!(".{name}.{pid}.{unique}.tmp")
+}
+
+/// The directory and file name of `path` (`.` and `out` when they are missing).
+fn split(path: &Path) -> (PathBuf, String) {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
+        _ => PathBuf::from("."),
     };
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
+    (dir, name)
+}
+
+/// Removes the temporary files of writes to `path` whose process no longer runs (killed
+/// before it could clean up: `SIGKILL`, a power cut), and returns how many it removed.
+///
+/// Only files named as [`write_atomic`] names them for `path` are considered, and only on
+/// systems where a process's liveness can be checked (Linux, through `/proc`); elsewhere
+/// nothing is removed.
+pub fn remove_stale_temporaries(path: &Path) -> std::io::Result<usize> {
+    let proc_dir = Path::new("/proc/self");
+    if !proc_dir.exists() {
+        return Ok(0);
+    }
+    let (dir, name) = split(path);
+    let prefix = format!(".{name}.");
+    let mut removed: usize = 0;
+    for entry in std::fs::read_dir(&dir)? {
+        let entry = entry?;
+        let file_name = entry.file_name();
+        let Some(rest) = file_name
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|n| n.strip_suffix(".tmp"))
+        else {
+            continue;
+        };
+        let Some((pid, unique)) = rest.split_once('.') else {
+            continue;
+        };
+        let (Ok(pid), Ok(unique)) = (pid.parse::<u32>(), unique.parse::<u64>()) else {
+            continue;
+        };
+        // Exactly the name a writer would give it, and its writer is gone.
+        let own = pid == std::process::id();
+        if file_name.to_str() == Some(temporary_name(&name, pid, unique).as_str())
+            && !own
+            && !Path::new(&format!("/proc/{pid}")).exists()
+            && std::fs::remove_file(entry.path()).is_ok()
+        {
+            removed = removed.saturating_add(1);
+        }
+    }
+    Ok(removed)
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed to
+/// disk, then renamed over `path`, then the directory flushed. On any error the temporary
+/// file is removed and `path` is untouched; after [`abandon_writes`] it fails with
+/// [`std::io::ErrorKind::Interrupted`], also leaving `path` untouched.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let (dir, name) = split(path);
     static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let unique = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let tmp = dir.join(format!(".{name}.{}.{unique}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::OpenOptions::new()
+    let tmp = dir.join(temporary_name(&name, std::process::id(), unique));
+    // Created and registered under the lock, so an abandon either sees it or prevents it.
+    let mut file = {
+        let mut flight = in_flight();
+        if flight.abandoned {
+            return Err(interrupted());
+        }
+        let f = std::fs::OpenOptions::new()
             .write(true)
             .create_new(true)
             .open(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)?;
+        flight.paths.push(tmp.clone());
+        f
+    };
+    let result = (|| {
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        drop(file);
+        // Renamed under the lock: after an abandon no destination is replaced.
+        let mut flight = in_flight();
+        if flight.abandoned {
+            return Err(interrupted());
+        }
+        let renamed = std::fs::rename(&tmp, path);
+        flight.paths.retain(|p| p != &tmp);
+        drop(flight);
+        renamed?;
         // The rename is durable only once the directory entry is; best effort where
         // directories cannot be opened as files.
         if let Ok(d) = std::fs::File::open(&dir) {
@@ -254,6 +367,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
+        in_flight().paths.retain(|p| p != &tmp);
     }
     result
 }

@@ -1,0 +1,55 @@
+//! What the command may write, and what an interrupt leaves behind.
+//!
+//! A build never overwrites its own input (compared by file identity, so `./m.obj`, a
+//! symbolic or a hard link to it are all caught), and never replaces an existing file that
+//! is not a `.obbt` file (by its signature) unless `--force` says so. On Ctrl-C (or
+//! SIGTERM, SIGHUP) the temporary files of unfinished writes are removed before exiting
+//! with status 130.
+
+use super::Failure;
+use obbtree::format::layout::SIGNATURE;
+use std::io::Read;
+use std::path::Path;
+
+/// Whether `path` is a readable file starting with the `.obbt` signature.
+pub fn is_obbt(path: &Path) -> bool {
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && head == SIGNATURE
+}
+
+/// Refuses to write `output` when it is one of `inputs`, or when it exists, is not a
+/// `.obbt` file and `force` is off.
+pub fn check_output(output: &Path, inputs: &[&Path], force: bool) -> Result<(), Failure> {
+    let shown = output.display();
+    for input in inputs {
+        if same_file::is_same_file(input, output).unwrap_or(false) {
+            return Err(Failure(format!(
+                "{shown}: is the input {}; refusing to overwrite it (choose another -o)",
+                input.display()
+            )));
+        }
+    }
+    match std::fs::metadata(output) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(Failure(format!("{shown}: cannot check the output: {e}"))),
+        Ok(m) if m.is_dir() => Err(Failure(format!("{shown}: is a directory"))),
+        Ok(_) if is_obbt(output) || force => Ok(()),
+        Ok(_) => Err(Failure(format!(
+            "{shown}: exists and is not an .obbt file; refusing to replace it (use --force)"
+        ))),
+    }
+}
+
+/// Makes Ctrl-C, SIGTERM and SIGHUP remove unfinished temporary files and exit with 130.
+pub fn handle_interrupts() {
+    // Fails only if a handler is already set (never, in this binary); the default
+    // behaviour (exit at once) is then what remains.
+    let _ = ctrlc::set_handler(|| {
+        obbtree::format::abandon_writes();
+        eprintln!("obbtree: interrupted");
+        std::process::exit(130);
+    });
+}
