@@ -19,6 +19,10 @@
     )
 )]
 
+/// The nalgebra this crate's API uses (poses, points), re-exported so an application can
+/// name exactly these types without adding a second, possibly different nalgebra.
+pub use nalgebra;
+
 mod arr3;
 pub mod build;
 pub mod bv;

@@ -366,10 +366,11 @@ fn pose_batches_print_one_line_per_pose_in_order() {
         let single: serde_json::Value = serde_json::from_slice(&single.stdout).unwrap();
         assert_eq!(line["contacts"], single["contacts"], "pose {k}");
     }
-    std::fs::write(&poses, format!("{identity} {identity}\n1 2 3\n")).unwrap();
+    // Errors name the line (from 1) and the pose (from 0, as the "pose" field does).
+    std::fs::write(&poses, format!("{identity} {identity}\n\n1 2 3\n")).unwrap();
     assert_bad_input(
         &obbtree(&["collide", f, f, "--poses", poses.to_str().unwrap()]),
-        "poses.txt:2",
+        "poses.txt: line 3 (pose 1): expected 24 numbers",
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -645,5 +646,95 @@ fn a_build_removes_temporaries_of_a_killed_build() {
     build(&out, &[]);
     assert!(!stale.exists());
     assert!(other.exists() && live.exists());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// One pose in every --pose-format gives the same answer; a rotation printed with 4
+/// decimals is refused, or repaired with --orthonormalize and the repair reported.
+#[test]
+fn pose_formats_and_orthonormalize() {
+    let dir = scratch("pose-formats");
+    let tree = dir.join("cow.obbt");
+    build(&tree, &[]);
+    let t = tree.to_str().unwrap();
+    // 30 degrees about z, then 2 along x.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let (w, z) = (15f64.to_radians().cos(), 15f64.to_radians().sin());
+    let forms = [
+        ("rt", format!("{c},{},0,{s},{c},0,0,0,1,2,0,0", -s)),
+        ("tq-wxyz", format!("2,0,0,{w},0,0,{z}")),
+        ("tq-xyzw", format!("2 0 0 0 0 {z} {w}")),
+        (
+            "matrix4",
+            format!("{c},{},0,2,{s},{c},0,0,0,0,1,0,0,0,0,1", -s),
+        ),
+    ];
+    let distance = |extra: &[&str]| -> f64 {
+        let o = obbtree(&[&["distance", t, t, "--json"], extra].concat());
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["distance"].as_f64().unwrap()
+    };
+    let reference = distance(&["--pose-b", &forms[0].1]);
+    for (format, pose) in &forms {
+        let d = distance(&["--pose-format", format, "--pose-b", pose]);
+        assert!(
+            (d - reference).abs() < 1e-12,
+            "{format}: {d} vs {reference}"
+        );
+    }
+    // Batches take the format too: 7 + 7 numbers a line.
+    let poses = dir.join("tq.txt");
+    std::fs::write(
+        &poses,
+        format!("0 0 0 1 0 0 0 {}\n", forms[1].1.replace(',', " ")),
+    )
+    .unwrap();
+    let o = obbtree(&[
+        "distance",
+        t,
+        t,
+        "--pose-format",
+        "tq-wxyz",
+        "--poses",
+        poses.to_str().unwrap(),
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["distance"].as_f64().unwrap() - reference).abs() < 1e-12);
+    // Four decimals: refused, then repaired with a note.
+    let four = "0.8660,-0.5,0,0.5,0.8660,0,0,0,1,2,0,0";
+    assert_bad_input(
+        &obbtree(&["distance", t, t, "--pose-b", four]),
+        "--orthonormalize",
+    );
+    let o = obbtree(&[
+        "distance",
+        t,
+        t,
+        "--pose-b",
+        four,
+        "--orthonormalize",
+        "--json",
+    ]);
+    assert!(o.status.success());
+    let note = stderr(&o);
+    assert!(
+        note.starts_with("obbtree: note: --pose-b: rotation corrected by 1.9"),
+        "{note}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["distance"].as_f64().unwrap() - reference).abs() < 1e-4);
+    assert_bad_input(
+        &obbtree(&[
+            "distance",
+            t,
+            t,
+            "--pose-format",
+            "matrix4",
+            "--pose-b",
+            "1,0,0,2,0,1,0,0,0,0,1,0,0,0,1,1",
+        ]),
+        "0 0 0 1",
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -482,7 +482,15 @@ fn duplicated_vertices_and_triangles_change_nothing_for_hull_and_vertices() {
     let split: Vec<[u32; 3]> = faces
         .iter()
         .enumerate()
-        .map(|(k, f)| f.map(|i| if (k + i as usize) % 2 == 0 { i } else { i + 40 }))
+        .map(|(k, f)| {
+            f.map(|i| {
+                if (k + i as usize).is_multiple_of(2) {
+                    i
+                } else {
+                    i + 40
+                }
+            })
+        })
         .collect();
     for m in [FitMethod::Hull, FitMethod::Vertices] {
         let r = principal_axes(m, &pos, &faces);

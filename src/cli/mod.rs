@@ -5,6 +5,7 @@ mod build;
 mod demo;
 mod files;
 mod info;
+mod poses;
 mod print;
 mod query;
 mod verify;

@@ -2,6 +2,7 @@
 
 use super::build::{build_with_progress, load_mesh, TreeArgs};
 use super::files::is_obbt;
+use super::poses::PoseArgs;
 use super::print::{self, out};
 use super::Failure;
 use clap::{Args, ValueEnum};
@@ -23,18 +24,8 @@ pub struct QueryInputs {
     pub a: PathBuf,
     /// Model B: a .obbt file, or a mesh built in memory first.
     pub b: PathBuf,
-    /// Pose of A: 12 comma-separated numbers, the rotation row-major then the translation
-    /// (default: identity).
-    #[arg(long, value_name = "P", allow_hyphen_values = true)]
-    pub pose_a: Option<String>,
-    /// Pose of B, as --pose-a.
-    #[arg(long, value_name = "P", allow_hyphen_values = true)]
-    pub pose_b: Option<String>,
-    /// A batch of poses: each non-empty line holds 24 numbers (pose A then pose B)
-    /// separated by spaces or commas. Prints one JSON object per line, in input order, each
-    /// with "pose": its line index from 0; queries run in parallel.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["pose_a", "pose_b"])]
-    pub poses: Option<PathBuf>,
+    #[command(flatten)]
+    pub poses: PoseArgs,
     /// Which tree to descend when both can be: larger diameter, volume or area, or always
     /// A or B.
     #[arg(long, value_enum, default_value_t = RuleArg::Diameter)]
@@ -170,66 +161,6 @@ fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
     ))
 }
 
-/// Parses 12 pose numbers from text separated by commas and/or spaces.
-fn parse_pose(text: &str, what: &str) -> Result<Pose, Failure> {
-    let values = parse_numbers(text, what)?;
-    Pose::from_row_major(&values).map_err(|e| Failure(format!("{what}: {e}")))
-}
-
-fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>, Failure> {
-    text.split(|c: char| c == ',' || c.is_whitespace())
-        .filter(|t| !t.is_empty())
-        .enumerate()
-        .map(|(i, t)| {
-            t.parse::<f64>()
-                .map_err(|_| Failure(format!("{what}: value {i} ({t:?}) is not a number")))
-        })
-        .collect()
-}
-
-/// The pose pairs to run: one from the flags, or a batch from a file.
-fn poses(inputs: &QueryInputs) -> Result<Option<Vec<(Pose, Pose)>>, Failure> {
-    let Some(path) = &inputs.poses else {
-        return Ok(None);
-    };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| Failure(format!("{}: {e}", path.display())))?;
-    let mut out = Vec::new();
-    for (line_no, line) in text.lines().enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let what = format!("{}:{}", path.display(), line_no + 1);
-        let values = parse_numbers(line, &what)?;
-        let Some((a, b)) = values.split_at_checked(12).filter(|_| values.len() == 24) else {
-            return Err(Failure(format!(
-                "{what}: expected 24 numbers (pose A then pose B), got {}",
-                values.len()
-            )));
-        };
-        let a = Pose::from_row_major(a).map_err(|e| Failure(format!("{what}: pose A: {e}")))?;
-        let b = Pose::from_row_major(b).map_err(|e| Failure(format!("{what}: pose B: {e}")))?;
-        out.push((a, b));
-    }
-    Ok(Some(out))
-}
-
-fn single_pose(inputs: &QueryInputs) -> Result<(Pose, Pose), Failure> {
-    let a = inputs
-        .pose_a
-        .as_deref()
-        .map(|t| parse_pose(t, "--pose-a"))
-        .transpose()?
-        .unwrap_or_default();
-    let b = inputs
-        .pose_b
-        .as_deref()
-        .map(|t| parse_pose(t, "--pose-b"))
-        .transpose()?
-        .unwrap_or_default();
-    Ok((a, b))
-}
-
 fn stats_json(s: &Stats) -> Value {
     json!({
         "bv_disjoint": s.bv_disjoint,
@@ -288,9 +219,9 @@ fn run_query<F>(inputs: &QueryInputs, query: F) -> Result<(), Failure>
 where
     F: Fn(&Pose, &Pose, &mut QueryContext) -> Result<Answer, Failure> + Sync,
 {
-    match poses(inputs)? {
+    match inputs.poses.batch()? {
         None => {
-            let (a, b) = single_pose(inputs)?;
+            let (a, b) = inputs.poses.single()?;
             let (value, text) = query(&a, &b, &mut QueryContext::new())?;
             if inputs.json {
                 out!("{value}")?;

@@ -325,7 +325,7 @@ impl ObbtFile {
             return Err(FormatError::BigEndianHost);
         }
         let bytes = backing.bytes();
-        if bytes.as_ptr().addr() % SECTION_ALIGN_BYTES != 0 {
+        if !bytes.as_ptr().addr().is_multiple_of(SECTION_ALIGN_BYTES) {
             return Err(FormatError::Misaligned);
         }
         let checked = check_header(bytes)?;
@@ -474,7 +474,7 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
         if info.flags & !FLAG_REQUIRED != 0 {
             return Err(bad(format!("unknown flags {:#x}", info.flags)));
         }
-        if info.offset % SECTION_ALIGN != 0 || info.offset < data_start {
+        if !info.offset.is_multiple_of(SECTION_ALIGN) || info.offset < data_start {
             return Err(bad(format!(
                 "offset {} is not a multiple of {SECTION_ALIGN} at or after the directory's end ({data_start})",
                 info.offset

@@ -33,7 +33,7 @@ pub use distance::{
     DistanceResult, ToleranceResult,
 };
 pub use engine::QueryContext;
-pub use pose::{Pose, PoseError, ORTHONORMAL_TOLERANCE};
+pub use pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
 pub use span::{span, span_files, SpanResult};
 pub use stats::Stats;
 

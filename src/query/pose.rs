@@ -1,7 +1,7 @@
 //! Poses of models in the world, and their validation.
 
 use crate::bv::pair::Transform;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// Largest deviation of `RᵀR` from the identity accepted for a rotation.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-6;
@@ -27,7 +27,7 @@ pub enum PoseError {
         value: f64,
     },
     /// The rotation is not orthonormal within [`ORTHONORMAL_TOLERANCE`].
-    #[error("rotation is not orthonormal: |RᵀR − I| reaches {deviation:.3e} (tolerance {ORTHONORMAL_TOLERANCE:e})")]
+    #[error("rotation is not orthonormal: |RᵀR − I| reaches {deviation:.3e} (tolerance {ORTHONORMAL_TOLERANCE:e}; --orthonormalize takes the nearest rotation)")]
     NotOrthonormal {
         /// Largest entry of `|RᵀR − I|`.
         deviation: f64,
@@ -38,9 +38,191 @@ pub enum PoseError {
         /// The determinant.
         determinant: f64,
     },
-    /// Not 12 numbers.
-    #[error("a pose has 12 numbers (rotation row-major, then translation), got {0}")]
-    WrongCount(usize),
+    /// Not as many numbers as the format has.
+    #[error("a pose in format {} has {} numbers ({}), got {got}", format.name(), format.numbers(), format.layout())]
+    WrongCount {
+        /// The format expected.
+        format: PoseFormat,
+        /// How many numbers were given.
+        got: usize,
+    },
+    /// A quaternion whose norm is not 1 within [`ORTHONORMAL_TOLERANCE`].
+    #[error("quaternion norm {norm} is not 1 within {ORTHONORMAL_TOLERANCE:e} (--orthonormalize normalises it)")]
+    NotUnitQuaternion {
+        /// Its norm.
+        norm: f64,
+    },
+    /// A 4×4 matrix whose last row is not `0 0 0 1`.
+    #[error("a 4x4 pose matrix must end in the row 0 0 0 1, got {row:?}")]
+    NotRigid {
+        /// The last row as given.
+        row: [f64; 4],
+    },
+    /// A repair asked for would change the rotation by more than [`MAX_REPAIR`]: the
+    /// numbers are not a rounded rotation but something else (a scale, a shear).
+    #[error("the nearest rotation is {correction:.3e} away (more than {MAX_REPAIR:e}): a scaled or sheared matrix, not a rounded rotation")]
+    BeyondRepair {
+        /// The largest entry change the repair would make.
+        correction: f64,
+    },
+}
+
+/// The largest change [`PoseFormat::parse`] makes when asked to repair a rotation: enough
+/// for rotations printed with 3 or 4 decimals (errors near 1e-4), far too little to turn a
+/// scaled or sheared matrix into a rotation silently.
+pub const MAX_REPAIR: f64 = 1e-2;
+
+/// How the numbers of a pose are laid out. Nothing is guessed: the count must match.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum PoseFormat {
+    /// 12 numbers: the rotation row-major, then the translation (`world = R p + T`).
+    #[default]
+    RotationTranslation,
+    /// 7 numbers: the translation, then a unit quaternion `w x y z` (Eigen's constructor
+    /// order).
+    TranslationQuaternionWxyz,
+    /// 7 numbers: the translation, then a unit quaternion `x y z w` (ROS messages, Eigen's
+    /// `coeffs()`, SciPy).
+    TranslationQuaternionXyzw,
+    /// 16 numbers: a 4×4 homogeneous matrix, row-major, `[R T; 0 0 0 1]`.
+    Matrix4,
+}
+
+/// A pose read from numbers, and how much it was repaired.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParsedPose {
+    /// The pose (exactly as given when no repair was asked for).
+    pub pose: Pose,
+    /// The repair made: the largest change of a rotation entry (nearest rotation), or the
+    /// quaternion's distance from norm 1; 0 without repair.
+    pub correction: f64,
+}
+
+impl PoseFormat {
+    /// Every format, default first.
+    pub const ALL: [PoseFormat; 4] = [
+        PoseFormat::RotationTranslation,
+        PoseFormat::TranslationQuaternionWxyz,
+        PoseFormat::TranslationQuaternionXyzw,
+        PoseFormat::Matrix4,
+    ];
+
+    /// The CLI and scene-file name: `rt`, `tq-wxyz`, `tq-xyzw`, `matrix4`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PoseFormat::RotationTranslation => "rt",
+            PoseFormat::TranslationQuaternionWxyz => "tq-wxyz",
+            PoseFormat::TranslationQuaternionXyzw => "tq-xyzw",
+            PoseFormat::Matrix4 => "matrix4",
+        }
+    }
+
+    /// Inverse of [`PoseFormat::name`].
+    pub fn from_name(name: &str) -> Option<PoseFormat> {
+        PoseFormat::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// How many numbers a pose has in this format.
+    pub fn numbers(self) -> usize {
+        match self {
+            PoseFormat::RotationTranslation => 12,
+            PoseFormat::TranslationQuaternionWxyz | PoseFormat::TranslationQuaternionXyzw => 7,
+            PoseFormat::Matrix4 => 16,
+        }
+    }
+
+    /// What the numbers are, in order.
+    pub fn layout(self) -> &'static str {
+        match self {
+            PoseFormat::RotationTranslation => "rotation row-major, then translation",
+            PoseFormat::TranslationQuaternionWxyz => "tx ty tz, then quaternion qw qx qy qz",
+            PoseFormat::TranslationQuaternionXyzw => "tx ty tz, then quaternion qx qy qz qw",
+            PoseFormat::Matrix4 => "4x4 matrix row-major, last row 0 0 0 1",
+        }
+    }
+
+    /// Reads a pose. Without `repair`, the rules of [`Pose::new`] apply (and a quaternion
+    /// must have norm 1 within 1e-6); with it, a rotation matrix is replaced by the nearest
+    /// rotation and a quaternion is normalised, refusing changes beyond [`MAX_REPAIR`] and
+    /// reflections.
+    pub fn parse(self, values: &[f64], repair: bool) -> Result<ParsedPose, PoseError> {
+        if values.len() != self.numbers() {
+            return Err(PoseError::WrongCount {
+                format: self,
+                got: values.len(),
+            });
+        }
+        for (index, &value) in values.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(PoseError::NotFinite { index, value });
+            }
+        }
+        let at = |i: usize| values.get(i).copied().unwrap_or(f64::NAN);
+        let matrix = |r: [usize; 9], t: [usize; 3]| {
+            let rotation = Matrix3::from_fn(|i, j| at(r.get(3 * i + j).copied().unwrap_or(0)));
+            (rotation, Vector3::new(at(t[0]), at(t[1]), at(t[2])))
+        };
+        let quaternion = |w: usize, x: usize, y: usize, z: usize| {
+            let q = Quaternion::new(at(w), at(x), at(y), at(z));
+            let translation = Vector3::new(at(0), at(1), at(2));
+            let error = (q.norm() - 1.0).abs();
+            if error > ORTHONORMAL_TOLERANCE && !repair {
+                return Err(PoseError::NotUnitQuaternion { norm: q.norm() });
+            }
+            if error > MAX_REPAIR {
+                return Err(PoseError::BeyondRepair { correction: error });
+            }
+            let pose = Pose::from_quaternion(&UnitQuaternion::from_quaternion(q), &translation)?;
+            let correction = if repair { error } else { 0.0 };
+            Ok(ParsedPose { pose, correction })
+        };
+        let (rotation, translation) = match self {
+            PoseFormat::TranslationQuaternionWxyz => return quaternion(3, 4, 5, 6),
+            PoseFormat::TranslationQuaternionXyzw => return quaternion(6, 3, 4, 5),
+            PoseFormat::RotationTranslation => matrix([0, 1, 2, 3, 4, 5, 6, 7, 8], [9, 10, 11]),
+            PoseFormat::Matrix4 => {
+                let row = [at(12), at(13), at(14), at(15)];
+                if row != [0.0, 0.0, 0.0, 1.0] {
+                    return Err(PoseError::NotRigid { row });
+                }
+                matrix([0, 1, 2, 4, 5, 6, 8, 9, 10], [3, 7, 11])
+            }
+        };
+        if !repair {
+            let pose = Pose::new(rotation, translation)?;
+            return Ok(ParsedPose {
+                pose,
+                correction: 0.0,
+            });
+        }
+        let (nearest, correction) = nearest_rotation(&rotation)?;
+        Ok(ParsedPose {
+            pose: Pose::new(nearest, translation)?,
+            correction,
+        })
+    }
+}
+
+/// The rotation nearest to `m` (Frobenius norm; the polar factor `U Vᵀ` of its SVD) and
+/// the largest entry change. A reflection (determinant < 0) has no nearest rotation worth
+/// taking, and a change beyond [`MAX_REPAIR`] is not a repair.
+fn nearest_rotation(m: &Matrix3<f64>) -> Result<(Matrix3<f64>, f64), PoseError> {
+    let determinant = m.determinant();
+    if determinant <= 0.0 {
+        return Err(PoseError::Reflection { determinant });
+    }
+    let svd = m.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Err(PoseError::BeyondRepair {
+            correction: f64::INFINITY,
+        });
+    };
+    let nearest = u * v_t;
+    let correction = (nearest - m).abs().max();
+    if correction > MAX_REPAIR {
+        return Err(PoseError::BeyondRepair { correction });
+    }
+    Ok((nearest, correction))
 }
 
 impl Default for Pose {
@@ -83,13 +265,33 @@ impl Pose {
         })
     }
 
-    /// A pose from 12 numbers: the rotation row by row, then the translation.
+    /// A pose from 12 numbers: the rotation row by row, then the translation
+    /// ([`PoseFormat::RotationTranslation`], no repair).
     pub fn from_row_major(values: &[f64]) -> Result<Pose, PoseError> {
-        let v: &[f64; 12] = values
-            .try_into()
-            .map_err(|_| PoseError::WrongCount(values.len()))?;
-        let rotation = Matrix3::new(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]);
-        Pose::new(rotation, Vector3::new(v[9], v[10], v[11]))
+        Ok(PoseFormat::RotationTranslation.parse(values, false)?.pose)
+    }
+
+    /// A pose from a unit quaternion and a translation (world units). nalgebra keeps
+    /// `UnitQuaternion` normalised, so only non-finite numbers are refused.
+    pub fn from_quaternion(
+        rotation: &UnitQuaternion<f64>,
+        translation: &Vector3<f64>,
+    ) -> Result<Pose, PoseError> {
+        Pose::new(*rotation.to_rotation_matrix().matrix(), *translation)
+    }
+
+    /// A pose from a nalgebra isometry (`world = iso * p`).
+    pub fn from_isometry(isometry: &Isometry3<f64>) -> Result<Pose, PoseError> {
+        Pose::from_quaternion(&isometry.rotation, &isometry.translation.vector)
+    }
+
+    /// The pose as a nalgebra isometry.
+    pub fn to_isometry(&self) -> Isometry3<f64> {
+        let rotation = Rotation3::from_matrix_unchecked(self.rotation);
+        Isometry3::from_parts(
+            Translation3::from(self.translation),
+            UnitQuaternion::from_rotation_matrix(&rotation),
+        )
     }
 
     /// A pure translation.

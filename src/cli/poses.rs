@@ -1,0 +1,182 @@
+//! Poses from the command line and from pose files, in any [`PoseFormat`], optionally
+//! repaired to the nearest rotation.
+
+use super::Failure;
+use clap::{Args, ValueEnum};
+use obbtree::query::{ParsedPose, Pose, PoseFormat, ORTHONORMAL_TOLERANCE};
+use std::path::PathBuf;
+
+/// Where the two models are: one pose pair from flags, or a batch file.
+#[derive(Args, Debug, Clone)]
+pub struct PoseArgs {
+    /// Pose of A (default: identity): numbers in the --pose-format, separated by commas or
+    /// spaces. World point = R p + T.
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
+    pub pose_a: Option<String>,
+    /// Pose of B, as --pose-a.
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
+    pub pose_b: Option<String>,
+    /// A batch of poses: each non-empty line holds pose A then pose B (24 numbers in the
+    /// default format) separated by spaces or commas. Prints one JSON object per pose, in
+    /// input order, each with "pose": its index from 0 (blank lines do not count); queries
+    /// run in parallel.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["pose_a", "pose_b"])]
+    pub poses: Option<PathBuf>,
+    /// How the numbers of a pose are laid out: rt = rotation row-major then translation
+    /// (12); tq-wxyz = translation then unit quaternion w x y z (7); tq-xyzw = translation
+    /// then quaternion x y z w, as in ROS (7); matrix4 = 4x4 row-major matrix with last row
+    /// 0 0 0 1 (16).
+    #[arg(long, value_enum, default_value_t = PoseFormatArg::Rt, value_name = "FORMAT")]
+    pub pose_format: PoseFormatArg,
+    /// Replace each rotation by the nearest rotation (a quaternion by its normalisation),
+    /// for poses printed with few decimals; corrections above 1e-6 are reported on stderr,
+    /// above 1e-2 refused. Without it a rotation must be orthonormal within 1e-6.
+    #[arg(long)]
+    pub orthonormalize: bool,
+}
+
+/// `--pose-format` values, named as [`PoseFormat::name`].
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum PoseFormatArg {
+    /// Rotation row-major, then translation: 12 numbers.
+    Rt,
+    /// Translation, then unit quaternion w x y z: 7 numbers.
+    #[value(name = "tq-wxyz")]
+    TqWxyz,
+    /// Translation, then unit quaternion x y z w (ROS order): 7 numbers.
+    #[value(name = "tq-xyzw")]
+    TqXyzw,
+    /// 4x4 homogeneous matrix, row-major: 16 numbers.
+    Matrix4,
+}
+
+impl PoseFormatArg {
+    /// The library format.
+    pub fn format(self) -> PoseFormat {
+        match self {
+            PoseFormatArg::Rt => PoseFormat::RotationTranslation,
+            PoseFormatArg::TqWxyz => PoseFormat::TranslationQuaternionWxyz,
+            PoseFormatArg::TqXyzw => PoseFormat::TranslationQuaternionXyzw,
+            PoseFormatArg::Matrix4 => PoseFormat::Matrix4,
+        }
+    }
+}
+
+/// Numbers separated by commas and/or white space; `what` names the source in errors.
+pub fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>, Failure> {
+    text.split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .enumerate()
+        .map(|(i, t)| {
+            t.parse::<f64>()
+                .map_err(|_| Failure(format!("{what}: value {i} ({t:?}) is not a number")))
+        })
+        .collect()
+}
+
+/// The repairs made while reading poses, reported once on stderr.
+#[derive(Default)]
+struct Repairs {
+    count: usize,
+    largest: f64,
+    at: String,
+}
+
+impl Repairs {
+    fn note(&mut self, parsed: &ParsedPose, at: impl FnOnce() -> String) -> Pose {
+        if parsed.correction > ORTHONORMAL_TOLERANCE {
+            self.count += 1;
+            if parsed.correction > self.largest {
+                self.largest = parsed.correction;
+                self.at = at();
+            }
+        }
+        parsed.pose
+    }
+
+    fn report(&self, source: &str) {
+        match self.count {
+            0 => {}
+            1 => eprintln!(
+                "obbtree: note: {}: rotation corrected by {:.3e} to the nearest rotation",
+                self.at, self.largest
+            ),
+            n => eprintln!(
+                "obbtree: note: {source}: {n} rotations corrected by more than {ORTHONORMAL_TOLERANCE:e}, the most by {:.3e} ({})",
+                self.largest, self.at
+            ),
+        }
+    }
+}
+
+impl PoseArgs {
+    fn parse(&self, values: &[f64]) -> Result<ParsedPose, obbtree::query::PoseError> {
+        self.pose_format.format().parse(values, self.orthonormalize)
+    }
+
+    /// The pose pair of --pose-a / --pose-b (identity where absent).
+    pub fn single(&self) -> Result<(Pose, Pose), Failure> {
+        let mut repairs = Repairs::default();
+        let mut one = |text: Option<&str>, flag: &str| -> Result<Pose, Failure> {
+            let Some(text) = text else {
+                return Ok(Pose::identity());
+            };
+            let parsed = self
+                .parse(&parse_numbers(text, flag)?)
+                .map_err(|e| Failure(format!("{flag}: {e}")))?;
+            Ok(repairs.note(&parsed, || flag.to_string()))
+        };
+        let a = one(self.pose_a.as_deref(), "--pose-a")?;
+        let b = one(self.pose_b.as_deref(), "--pose-b")?;
+        repairs.report("--pose-a/--pose-b");
+        Ok((a, b))
+    }
+
+    /// The pose pairs of the --poses file, or `None` without one. Errors name the file,
+    /// the line (from 1) and the pose (from 0, as the output's "pose" field).
+    pub fn batch(&self) -> Result<Option<Vec<(Pose, Pose)>>, Failure> {
+        let Some(path) = &self.poses else {
+            return Ok(None);
+        };
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Failure(format!("{}: {e}", path.display())))?;
+        let per_pose = self.pose_format.format().numbers();
+        let mut repairs = Repairs::default();
+        let mut out = Vec::new();
+        for (line_no, line) in text.lines().enumerate() {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let what = format!(
+                "{}: line {} (pose {})",
+                path.display(),
+                line_no + 1,
+                out.len()
+            );
+            let values = parse_numbers(line, &what)?;
+            let Some((a, b)) = values
+                .split_at_checked(per_pose)
+                .filter(|_| values.len() == 2 * per_pose)
+            else {
+                return Err(Failure(format!(
+                    "{what}: expected {} numbers (pose A then pose B, {} each in format {}), got {}",
+                    2 * per_pose,
+                    per_pose,
+                    self.pose_format.format().name(),
+                    values.len()
+                )));
+            };
+            let mut pose = |values: &[f64], which: &str| -> Result<Pose, Failure> {
+                let parsed = self
+                    .parse(values)
+                    .map_err(|e| Failure(format!("{what}: pose {which}: {e}")))?;
+                Ok(repairs.note(&parsed, || format!("{what}, pose {which}")))
+            };
+            let a = pose(a, "A")?;
+            let b = pose(b, "B")?;
+            out.push((a, b));
+        }
+        repairs.report(&path.display().to_string());
+        Ok(Some(out))
+    }
+}
