@@ -16,7 +16,7 @@ use obbtree::mesh::TriMesh;
 use obbtree::query::triangle::{triangle_distance, triangles_intersect, Triangle};
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, Pose, QueryContext,
+    DistanceOptions, PairQuery, Pose, QueryContext,
 };
 use proptest::prelude::*;
 
@@ -205,6 +205,44 @@ fn check_all(
                 prop_assert!(w.distance < t);
             }
         }
+        // The pair object answers as the free functions do; a limit gives `None` exactly
+        // when the distance reaches it; a warm start from any pair changes nothing but work.
+        let mut pair = PairQuery::new(&fa, &fb).unwrap();
+        let all = pair
+            .collide(pose_a, pose_b, &CollideOptions::default())
+            .unwrap();
+        prop_assert_eq!(&all.pairs, &brute.pairs);
+        let first = pair.first_contact(pose_a, pose_b).unwrap();
+        prop_assert_eq!(first.is_some(), !brute.pairs.is_empty());
+        prop_assert!(first.is_none_or(|p| brute.pairs.contains(&p)));
+        let exact = DistanceOptions::default();
+        let scale = 1.0 + brute.min_distance;
+        for limit in [brute.min_distance * 0.5, brute.min_distance * 1.5 + 1e-9] {
+            let (r, _) = pair.distance_below(pose_a, pose_b, &exact, limit).unwrap();
+            match r {
+                Some(r) => {
+                    prop_assert!(brute.min_distance < limit);
+                    prop_assert!((r.distance - brute.min_distance).abs() <= 1e-9 * scale);
+                }
+                None => prop_assert!(brute.min_distance >= limit - 1e-9 * scale),
+            }
+        }
+        let cold = pair.distance(pose_a, pose_b, &exact).unwrap();
+        let moved = Pose::new(
+            *pose_b.rotation(),
+            pose_b.translation_vector() + Vector3::new(0.3, -0.2, 0.1),
+        )
+        .unwrap();
+        let elsewhere = pair.distance(pose_a, &moved, &exact).unwrap().witness;
+        for start in [cold.witness, elsewhere] {
+            let warm = DistanceOptions {
+                warm_start: Some(start),
+                ..DistanceOptions::default()
+            };
+            let d = pair.distance(pose_a, pose_b, &warm).unwrap();
+            prop_assert!((d.distance - brute.min_distance).abs() <= 1e-9 * scale);
+            prop_assert!(d.stats.tri_separated + d.stats.tri_contact >= 1);
+        }
         // Approximate distance keeps its documented guarantee.
         for (rel, abs) in [(0.1, 0.0), (0.0, 0.05), (0.5, 0.01)] {
             let o = DistanceOptions {
@@ -268,4 +306,82 @@ fn queries_match_brute_force_at_small_and_large_scales() {
             check_all(&a, &b, &Pose::identity(), &pb).unwrap();
         }
     }
+}
+
+#[test]
+fn a_pair_query_refuses_trees_of_different_kinds_and_reuses_its_buffers() {
+    let cow = common::cow();
+    let obb = build(&cow, &obbtree::build::BuildOptions::default(), None).unwrap();
+    let aabb = build(
+        &cow,
+        &obbtree::build::BuildOptions {
+            bv: obbtree::bv::BvKind::Aabb,
+            ..Default::default()
+        },
+        None,
+    )
+    .unwrap();
+    assert!(PairQuery::new(&obb, &aabb).is_err());
+    let mut pair = PairQuery::new(&obb, &obb).unwrap();
+    let shifted = Pose::translation(0.2, 0.0, 0.0);
+    let mut result = pair
+        .collide(&Pose::identity(), &shifted, &CollideOptions::default())
+        .unwrap();
+    assert!(result.pairs.len() > 100, "{}", result.pairs.len());
+    let buffer = result.pairs.as_ptr();
+    // Fewer contacts further out: the same buffer holds them.
+    let further = Pose::translation(0.5, 0.0, 0.0);
+    pair.collide_into(
+        &Pose::identity(),
+        &further,
+        &CollideOptions::default(),
+        &mut result,
+    )
+    .unwrap();
+    assert_eq!(result.pairs.as_ptr(), buffer);
+    let mut context = QueryContext::new();
+    let expected = collide_files(
+        &obb,
+        &Pose::identity(),
+        &obb,
+        &further,
+        &CollideOptions::default(),
+        &mut context,
+    )
+    .unwrap();
+    assert_eq!(result, expected);
+}
+
+/// Over a smooth trajectory the previous answer's pair bounds the next query from the
+/// start: the same distances, fewer triangle and box tests.
+#[test]
+fn warm_started_distances_equal_cold_ones_with_less_work() {
+    let cow = common::cow();
+    let file = build(&cow, &obbtree::build::BuildOptions::default(), None).unwrap();
+    let mut pair = PairQuery::new(&file, &file).unwrap();
+    let (mut cold_work, mut warm_work) = (0, 0);
+    let mut previous = None;
+    for step in 0..50 {
+        let t = f64::from(step) * 0.02;
+        let rotation = *Rotation3::from_euler_angles(0.0, 0.3 * t, t).matrix();
+        let pose = Pose::new(rotation, Vector3::new(1.3 + 0.2 * t.sin(), 0.1 * t, 0.0)).unwrap();
+        let cold = pair
+            .distance(&Pose::identity(), &pose, &DistanceOptions::default())
+            .unwrap();
+        let warm = pair
+            .distance(
+                &Pose::identity(),
+                &pose,
+                &DistanceOptions {
+                    warm_start: previous,
+                    ..DistanceOptions::default()
+                },
+            )
+            .unwrap();
+        assert_eq!(warm.distance, cold.distance, "step {step}");
+        previous = Some(warm.witness);
+        cold_work += cold.stats.nodes_visited;
+        warm_work += warm.stats.nodes_visited;
+    }
+    assert!(warm_work < cold_work, "warm {warm_work} cold {cold_work}");
 }

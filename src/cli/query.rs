@@ -299,6 +299,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         rel_err: args.rel_err,
         abs_err: args.abs_err,
         rule,
+        ..DistanceOptions::default()
     };
     run_query(&args.inputs, |pa, pb, context| {
         let started = Instant::now();

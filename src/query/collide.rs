@@ -95,24 +95,46 @@ pub fn collide<B: BoundingVolume>(
     options: &CollideOptions,
     context: &mut QueryContext,
 ) -> Result<CollideResult, QueryError> {
+    let mut result = CollideResult {
+        colliding: false,
+        pairs: Vec::new(),
+        stats: Stats::default(),
+    };
+    collide_into(a, pose_a, b, pose_b, options, context, &mut result)?;
+    Ok(result)
+}
+
+/// [`collide`] writing into `result`, whose pair buffer is reused (cleared, not freed), so
+/// that a query per frame allocates nothing once the buffers have grown.
+pub fn collide_into<B: BoundingVolume>(
+    a: &TreeView<'_, B>,
+    pose_a: &Pose,
+    b: &TreeView<'_, B>,
+    pose_b: &Pose,
+    options: &CollideOptions,
+    context: &mut QueryContext,
+    result: &mut CollideResult,
+) -> Result<(), QueryError> {
     let xf = Pose::relative(pose_a, pose_b);
+    let mut faces = std::mem::take(&mut context.faces);
+    faces.clear();
     let mut policy = Collide {
         guard: options.guard,
         first: options.first_contact,
-        faces: Vec::new(),
+        faces,
     };
-    let stats = traverse(a, b, &xf, options.rule, &mut policy, context)?;
-    let mut pairs = policy
-        .faces
-        .iter()
-        .map(|&(fa, fb)| Ok((source_id(a, fa, 'A')?, source_id(b, fb, 'B')?)))
-        .collect::<Result<Vec<_>, QueryError>>()?;
-    pairs.sort_unstable();
-    Ok(CollideResult {
-        colliding: !pairs.is_empty(),
-        pairs,
-        stats,
-    })
+    let traversal = traverse(a, b, &xf, options.rule, &mut policy, context);
+    context.faces = policy.faces;
+    result.stats = traversal?;
+    result.pairs.clear();
+    for &(fa, fb) in &context.faces {
+        result
+            .pairs
+            .push((source_id(a, fa, 'A')?, source_id(b, fb, 'B')?));
+    }
+    result.pairs.sort_unstable();
+    result.colliding = !result.pairs.is_empty();
+    Ok(())
 }
 
 /// [`collide`] on two files, dispatched once on their volume type and precision.

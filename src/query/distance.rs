@@ -1,4 +1,5 @@
-//! Separation distance: exact, approximate within error bounds, and "closer than t?".
+//! Separation distance: exact, approximate within error bounds, below a limit, and
+//! "closer than t?".
 
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangle_distance, Triangle};
@@ -23,6 +24,21 @@ pub struct DistanceOptions {
     pub abs_err: f64,
     /// Which tree to descend when both can be.
     pub rule: DescentRule,
+    /// The triangle pair of an earlier answer for the same two trees
+    /// ([`DistanceResult::witness`]). Its distance at the new poses is measured first and
+    /// bounds the search from the start: over a smooth trajectory the closest pair moves
+    /// little, so most of the tree is pruned at once (the coherence PQP and SWIFT++ use).
+    /// It changes the work, never the guarantee; a pair out of range is ignored, and the
+    /// measurement counts as one more triangle test in the statistics.
+    pub warm_start: Option<Witness>,
+}
+
+/// The triangle pair behind a distance answer, as leaf-ordered faces of its two trees: a
+/// hint for the next query of the same trees ([`DistanceOptions::warm_start`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Witness {
+    face_a: u32,
+    face_b: u32,
 }
 
 /// The answer of a distance query.
@@ -38,6 +54,8 @@ pub struct DistanceResult {
     pub tri_a: u32,
     /// Input-mesh id of the triangle of B holding `point_b`.
     pub tri_b: u32,
+    /// The same pair as a warm start for the next query of these trees.
+    pub witness: Witness,
     /// Work done.
     pub stats: Stats,
 }
@@ -67,11 +85,37 @@ struct Best {
 struct Distance {
     rel_err: f64,
     abs_err: f64,
+    /// Pairs at or beyond this distance are of no interest (infinite: none is excluded).
+    limit: f64,
     /// Stop as soon as a pair is closer than this (tolerance queries); `-1` otherwise.
     stop_below: f64,
     best: Best,
-    /// No pair measured yet in a distance query (tolerance queries prune from the start).
-    unmeasured: bool,
+}
+
+impl Distance {
+    /// Measures one triangle pair and keeps it if it is the best so far.
+    fn measure(&mut self, fa: u32, a: &Triangle, fb: u32, b: &Triangle, stats: &mut Stats) -> Flow {
+        let d = triangle_distance(a, b);
+        if d.distance == 0.0 {
+            stats.tri_contact += 1;
+        } else {
+            stats.tri_separated += 1;
+        }
+        let first = self.best.faces.is_none() && !d.distance.is_nan();
+        if d.distance < self.best.distance || first {
+            self.best = Best {
+                distance: d.distance,
+                point_a: d.point_a,
+                point_b: d.point_b,
+                faces: Some((fa, fb)),
+            };
+            // Nothing can be closer than 0.
+            if d.distance == 0.0 || d.distance < self.stop_below {
+                return Flow::Stop;
+            }
+        }
+        Flow::Continue
+    }
 }
 
 impl<B: BoundingVolume> Policy<B> for Distance {
@@ -85,9 +129,11 @@ impl<B: BoundingVolume> Policy<B> for Distance {
     #[inline]
     fn keep(&self, key: f64) -> bool {
         let best = self.best.distance;
-        // Until a first pair is measured nothing is pruned: a pose far enough out overflows
-        // every bound to infinity, and the answer is then an infinite distance, not none.
-        (key * (1.0 + self.rel_err) < best && key + self.abs_err < best) || self.unmeasured
+        // Until a first pair is measured without a limit nothing is pruned: a pose far
+        // enough out overflows every bound to infinity, and the answer is then an infinite
+        // distance, not none.
+        (self.best.faces.is_none() && self.limit == f64::INFINITY)
+            || (key < self.limit && key * (1.0 + self.rel_err) < best && key + self.abs_err < best)
     }
 
     #[inline]
@@ -99,28 +145,7 @@ impl<B: BoundingVolume> Policy<B> for Distance {
         b: &Triangle,
         stats: &mut Stats,
     ) -> Flow {
-        let d = triangle_distance(a, b);
-        if d.distance == 0.0 {
-            stats.tri_contact += 1;
-        } else {
-            stats.tri_separated += 1;
-        }
-        let first = self.unmeasured && !d.distance.is_nan();
-        if first {
-            self.unmeasured = false;
-        }
-        if d.distance < self.best.distance || first {
-            self.best = Best {
-                distance: d.distance,
-                point_a: d.point_a,
-                point_b: d.point_b,
-                faces: Some((fa, fb)),
-            };
-            if d.distance == 0.0 || d.distance < self.stop_below {
-                return Flow::Stop;
-            }
-        }
-        Flow::Continue
+        self.measure(fa, a, fb, b, stats)
     }
 }
 
@@ -136,6 +161,19 @@ fn check(name: &'static str, value: f64) -> Result<(), QueryError> {
     }
 }
 
+/// Triangle `face` of `tree` mapped by `xf`, if the tree holds it.
+fn mapped_triangle<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    face: u32,
+    xf: &Transform,
+) -> Option<Triangle> {
+    tree.triangle(face)
+        .map(|t| t.map(|p| xf.apply(&Vector3::from(p))))
+}
+
+/// Runs the distance traversal: the warm start first, then the tree pairs. The best pair
+/// found below `policy.limit` (any, without a limit), in world terms.
+#[allow(clippy::too_many_arguments)]
 fn run<B: BoundingVolume>(
     a: &TreeView<'_, B>,
     pose_a: &Pose,
@@ -143,23 +181,65 @@ fn run<B: BoundingVolume>(
     pose_b: &Pose,
     mut policy: Distance,
     rule: DescentRule,
+    warm_start: Option<Witness>,
     context: &mut QueryContext,
 ) -> Result<(Option<DistanceResult>, Stats), QueryError> {
     let xf = Pose::relative(pose_a, pose_b);
-    let stats = traverse(a, b, &xf, rule, &mut policy, context)?;
+    let mut warm = Stats::default();
+    let mut flow = Flow::Continue;
+    if let Some(w) = warm_start {
+        let pair = (
+            mapped_triangle(a, w.face_a, &Transform::identity()),
+            mapped_triangle(b, w.face_b, &xf),
+        );
+        if let (Some(ta), Some(tb)) = pair {
+            flow = policy.measure(w.face_a, &ta, w.face_b, &tb, &mut warm);
+        }
+    }
+    let mut stats = match flow {
+        Flow::Continue => traverse(a, b, &xf, rule, &mut policy, context)?,
+        Flow::Stop => Stats::default(),
+    };
+    stats.tri_separated += warm.tri_separated;
+    stats.tri_contact += warm.tri_contact;
     let best = policy.best;
     let Some(faces) = best.faces else {
         return Ok((None, stats));
     };
+    if !(best.distance < policy.limit || policy.limit == f64::INFINITY) {
+        return Ok((None, stats));
+    }
     let result = DistanceResult {
         distance: best.distance,
         point_a: pose_a.apply(&best.point_a),
         point_b: pose_a.apply(&best.point_b),
         tri_a: source_id(a, faces.0, 'A')?,
         tri_b: source_id(b, faces.1, 'B')?,
+        witness: Witness {
+            face_a: faces.0,
+            face_b: faces.1,
+        },
         stats,
     };
     Ok((Some(result), stats))
+}
+
+/// The policy of a distance query with these options and limit.
+fn policy(options: &DistanceOptions, limit: f64) -> Result<Distance, QueryError> {
+    check("rel_err", options.rel_err)?;
+    check("abs_err", options.abs_err)?;
+    Ok(Distance {
+        rel_err: options.rel_err,
+        abs_err: options.abs_err,
+        limit,
+        stop_below: -1.0,
+        best: Best {
+            distance: f64::INFINITY,
+            point_a: Vector3::zeros(),
+            point_b: Vector3::zeros(),
+            faces: None,
+        },
+    })
 }
 
 /// The distance between two posed trees, exact or within the errors of `options`.
@@ -171,27 +251,39 @@ pub fn distance<B: BoundingVolume>(
     options: &DistanceOptions,
     context: &mut QueryContext,
 ) -> Result<DistanceResult, QueryError> {
-    check("rel_err", options.rel_err)?;
-    check("abs_err", options.abs_err)?;
-    let none = Best {
-        distance: f64::INFINITY,
-        point_a: Vector3::zeros(),
-        point_b: Vector3::zeros(),
-        faces: None,
-    };
-    let policy = Distance {
-        rel_err: options.rel_err,
-        abs_err: options.abs_err,
-        stop_below: -1.0,
-        best: none,
-        unmeasured: true,
-    };
-    let (result, _) = run(a, pose_a, b, pose_b, policy, options.rule, context)?;
+    let policy = policy(options, f64::INFINITY)?;
+    let warm = options.warm_start;
+    let (result, _) = run(a, pose_a, b, pose_b, policy, options.rule, warm, context)?;
     // Every tree has a face, so some triangle pair was measured unless the tree is corrupt.
     result.ok_or(QueryError::CorruptTree {
         which: 'A',
         what: "no triangle pair reached",
     })
+}
+
+/// The distance between two posed trees if it is below `limit` (exact, or within the
+/// errors of `options`), else `None` (with the work done). Volume pairs at least `limit`
+/// apart are never opened: a distance wanted only up to a range costs what its range
+/// needs. `None` is exact: the true distance is at least `limit`.
+pub fn distance_below<B: BoundingVolume>(
+    a: &TreeView<'_, B>,
+    pose_a: &Pose,
+    b: &TreeView<'_, B>,
+    pose_b: &Pose,
+    options: &DistanceOptions,
+    limit: f64,
+    context: &mut QueryContext,
+) -> Result<(Option<DistanceResult>, Stats), QueryError> {
+    if limit.is_nan() || limit < 0.0 {
+        return Err(QueryError::BadOption {
+            name: "limit",
+            requirement: "a number >= 0",
+            value: limit,
+        });
+    }
+    let policy = policy(options, limit)?;
+    let warm = options.warm_start;
+    run(a, pose_a, b, pose_b, policy, options.rule, warm, context)
 }
 
 /// Whether two posed trees come closer than `tolerance`; stops as soon as it knows.
@@ -205,27 +297,10 @@ pub fn within_tolerance<B: BoundingVolume>(
     context: &mut QueryContext,
 ) -> Result<ToleranceResult, QueryError> {
     check("tolerance", tolerance)?;
-    // Starting the best at the tolerance prunes every pair that cannot come closer.
-    let start = Best {
-        distance: tolerance,
-        point_a: Vector3::zeros(),
-        point_b: Vector3::zeros(),
-        faces: None,
-    };
-    let policy = Distance {
-        rel_err: 0.0,
-        abs_err: 0.0,
-        stop_below: tolerance,
-        best: start,
-        unmeasured: false,
-    };
-    let mut found = None;
-    let (result, stats) = run(a, pose_a, b, pose_b, policy, rule, context)?;
-    if let Some(r) = result {
-        if r.distance < tolerance {
-            found = Some(r);
-        }
-    }
+    // Pairs that cannot come closer than the tolerance are pruned from the start.
+    let mut policy = policy(&DistanceOptions::default(), tolerance)?;
+    policy.stop_below = tolerance;
+    let (found, stats) = run(a, pose_a, b, pose_b, policy, rule, None, context)?;
     Ok(ToleranceResult {
         closer: found.is_some(),
         witness: found,

@@ -57,10 +57,12 @@ pub(crate) struct Pending {
 #[derive(Debug, Default)]
 pub struct QueryContext {
     pub(crate) stack: Vec<Pending>,
+    /// Contacting leaf-ordered face pairs of the running collision query.
+    pub(crate) faces: Vec<(u32, u32)>,
 }
 
 impl QueryContext {
-    /// An empty context; its stack grows to the largest traversal seen and stays.
+    /// An empty context; its buffers grow to the largest traversal seen and stay.
     pub fn new() -> QueryContext {
         QueryContext::default()
     }

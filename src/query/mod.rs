@@ -21,18 +21,20 @@ mod collide;
 mod descent;
 mod distance;
 mod engine;
+mod pair_query;
 mod pose;
 mod span;
 mod stats;
 pub mod triangle;
 
-pub use collide::{collide, collide_files, CollideOptions, CollideResult};
+pub use collide::{collide, collide_files, collide_into, CollideOptions, CollideResult};
 pub use descent::DescentRule;
 pub use distance::{
-    distance, distance_files, within_tolerance, within_tolerance_files, DistanceOptions,
-    DistanceResult, ToleranceResult,
+    distance, distance_below, distance_files, within_tolerance, within_tolerance_files,
+    DistanceOptions, DistanceResult, ToleranceResult, Witness,
 };
 pub use engine::QueryContext;
+pub use pair_query::PairQuery;
 pub use pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
 pub use span::{span, span_files, SpanResult};
 pub use stats::Stats;
