@@ -738,3 +738,50 @@ fn pose_formats_and_orthonormalize() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Mesh-only flags are refused where they cannot apply; numbers and durations print as
+/// people read them.
+#[test]
+fn flags_that_cannot_apply_and_readable_numbers() {
+    let dir = scratch("readable");
+    let tree = dir.join("cow.obbt");
+    build(&tree, &[]);
+    let t = tree.to_str().unwrap();
+    assert_bad_input(
+        &obbtree(&["collide", t, t, "--leaf-size", "4"]),
+        "--leaf-size applies to mesh inputs only",
+    );
+    assert_bad_input(
+        &obbtree(&["distance", t, &cow(), "--precision", "f64"]),
+        "stores f32",
+    );
+    // A mesh paired with a tree may still choose its fit and leaf size.
+    let o = obbtree(&[
+        "collide",
+        t,
+        &cow(),
+        "--fit",
+        "vertices",
+        "--leaf-size",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // 1e300 away: not a 301-digit number.
+    let o = obbtree(&["distance", t, t, "--pose-b", "1,0,0,0,1,0,0,0,1,1e300,0,0"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.starts_with("distance: 1e300 "), "{text}");
+    let o = obbtree(&["info", t]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    let bounds = text.lines().find(|l| l.contains("bounds")).unwrap();
+    assert!(
+        bounds
+            .split(|c: char| !c.is_ascii_digit())
+            .all(|digits| digits.len() <= 9),
+        "f32 bounds print as f32: {bounds}"
+    );
+    assert!(text.contains("1 face per leaf"), "{text}");
+    let o = obbtree(&["demo"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(!text.contains(" 0 us") && !text.contains(" 0 µs"), "{text}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -188,3 +188,37 @@ fn far_distances_stay_exact() {
         }
     }
 }
+
+/// Past about 1e13 model sizes away, f64 cannot tell the models' triangles apart: every
+/// pair is at the same rounded distance, and bounds within rounding of it once opened
+/// every pair (33.7 million, 20 s at 1e300). Candidates within the bounds' resolution of
+/// the best (a relative 6e-14) are no longer opened.
+#[test]
+fn models_beyond_f64_resolution_do_not_open_every_pair() {
+    let cow = common::cow();
+    let file = build(&cow, &BuildOptions::default(), None).unwrap();
+    let mut context = QueryContext::new();
+    for offset in [1e13, 1e16, 1e100, 1e300] {
+        let pose = Pose::translation(offset, 0.0, 0.0);
+        let r = distance_files(
+            &file,
+            &Pose::identity(),
+            &file,
+            &pose,
+            &DistanceOptions::default(),
+            &mut context,
+        )
+        .unwrap();
+        assert!(
+            triangle_tests(&r.stats) <= 1000,
+            "{offset:e}: {:?}",
+            r.stats
+        );
+        // The cow is about 1 unit wide: the distance is the offset less that.
+        assert!(
+            (r.distance - (offset - 1.0)).abs() <= 1.0 + 1e-13 * offset,
+            "{offset:e}: {}",
+            r.distance
+        );
+    }
+}

@@ -44,22 +44,25 @@ pub struct BuildArgs {
     pub force: bool,
 }
 
-/// Options that shape a tree, shared by every command that builds one.
+/// Options that shape a tree, shared by every command that builds one. Each is optional so
+/// that a query can tell a flag given from a default (it refuses flags that cannot apply).
 #[derive(Args, Debug, Clone)]
 pub struct TreeArgs {
-    /// Bounding volume of every node.
-    #[arg(long, value_enum, default_value_t = BvArg::Obb)]
-    pub bv: BvArg,
+    /// Bounding volume of every node [default: obb].
+    #[arg(long, value_enum)]
+    pub bv: Option<BvArg>,
     /// What the box frames are fitted to: the convex-hull surface (best boxes), the
-    /// triangles (area-weighted), or the vertices.
-    #[arg(long, value_enum, default_value_t = FitArg::Hull)]
-    pub fit: FitArg,
-    /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding.
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    pub leaf_size: u32,
-    /// Stored precision of vertices and volumes (queries always compute in f64).
-    #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
-    pub precision: PrecisionArg,
+    /// triangles (area-weighted), or the vertices [default: hull].
+    #[arg(long, value_enum)]
+    pub fit: Option<FitArg>,
+    /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
+    /// [default: 1].
+    #[arg(long, value_name = "N")]
+    pub leaf_size: Option<u32>,
+    /// Stored precision of vertices and volumes (queries always compute in f64)
+    /// [default: f32].
+    #[arg(long, value_enum)]
+    pub precision: Option<PrecisionArg>,
 }
 
 /// `--bv` values.
@@ -94,25 +97,39 @@ pub enum PrecisionArg {
 }
 
 impl TreeArgs {
-    /// The library options these flags stand for.
+    /// The library options these flags stand for (defaults where absent).
     pub fn options(&self) -> BuildOptions {
+        let default = BuildOptions::default();
         BuildOptions {
-            bv: match self.bv {
+            bv: self.bv.map_or(default.bv, |bv| match bv {
                 BvArg::Obb => BvKind::Obb,
                 BvArg::Aabb => BvKind::Aabb,
                 BvArg::Sphere => BvKind::Sphere,
-            },
-            fit: match self.fit {
+            }),
+            fit: self.fit.map_or(default.fit, |fit| match fit {
                 FitArg::Hull => FitMethod::Hull,
                 FitArg::Triangles => FitMethod::Triangles,
                 FitArg::Vertices => FitMethod::Vertices,
-            },
-            precision: match self.precision {
+            }),
+            precision: self.precision.map_or(default.precision, |p| match p {
                 PrecisionArg::F32 => Precision::F32,
                 PrecisionArg::F64 => Precision::F64,
-            },
-            leaf_size: self.leaf_size,
+            }),
+            leaf_size: self.leaf_size.unwrap_or(default.leaf_size),
         }
+    }
+
+    /// The flags given on the command line, by name.
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            ("--bv", self.bv.is_some()),
+            ("--fit", self.fit.is_some()),
+            ("--leaf-size", self.leaf_size.is_some()),
+            ("--precision", self.precision.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(name, given)| given.then_some(name))
+        .collect()
     }
 }
 

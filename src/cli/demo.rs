@@ -3,17 +3,14 @@
 use super::build::build_with_progress;
 use super::files::check_output;
 use super::print::out;
-use super::{human_bytes, Failure};
+use super::{human_bytes, human_seconds, Failure};
 use clap::Args;
 use nalgebra::{Rotation3, Vector3};
 use obbtree::build::BuildOptions;
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
-use obbtree::query::{
-    collide_files, distance_files, span_files, CollideOptions, DescentRule, DistanceOptions, Pose,
-    QueryContext,
-};
+use obbtree::query::{CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -103,44 +100,34 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The three queries between two copies of the cow, the second turned and slid along x.
+/// The queries between two copies of the cow, the second turned and slid along x, through
+/// the pair object an application would keep.
 fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
     let cow = ObbtFile::open(path)?;
     let extent = cow.info().bounds_max[0] - cow.info().bounds_min[0];
-    let mut context = QueryContext::new();
+    let mut pair = PairQuery::new(&cow, &cow)?;
     let a = Pose::identity();
     out!("queries between two cows (A fixed, B turned 30 degrees about z and moved along x; lengths in model units):")?;
     for shift in [0.25, 0.6, 1.5] {
         let rotation = *Rotation3::from_euler_angles(0.0, 0.0, 30f64.to_radians()).matrix();
         let b = Pose::new(rotation, Vector3::new(shift * extent, 0.0, 0.0))?;
-        let started = Instant::now();
-        let all = collide_files(&cow, &a, &cow, &b, &CollideOptions::default(), &mut context)?;
-        let collide_us = started.elapsed().as_secs_f64() * 1e6;
-        let started = Instant::now();
-        let first = CollideOptions {
-            first_contact: true,
-            ..CollideOptions::default()
-        };
-        let any = collide_files(&cow, &a, &cow, &b, &first, &mut context)?;
-        let first_us = started.elapsed().as_secs_f64() * 1e6;
-        let started = Instant::now();
-        let gap = distance_files(
-            &cow,
-            &a,
-            &cow,
-            &b,
-            &DistanceOptions::default(),
-            &mut context,
-        )?;
-        let distance_us = started.elapsed().as_secs_f64() * 1e6;
-        let started = Instant::now();
-        let far = span_files(&cow, &a, &cow, &b, DescentRule::default(), &mut context)?;
-        let span_us = started.elapsed().as_secs_f64() * 1e6;
+        let timed = Instant::now();
+        let all = pair.collide(&a, &b, &CollideOptions::default())?;
+        let collide = human_seconds(timed.elapsed().as_secs_f64());
+        let timed = Instant::now();
+        let any = pair.first_contact(&a, &b)?;
+        let first = human_seconds(timed.elapsed().as_secs_f64());
+        let timed = Instant::now();
+        let gap = pair.distance(&a, &b, &DistanceOptions::default())?;
+        let distance = human_seconds(timed.elapsed().as_secs_f64());
+        let timed = Instant::now();
+        let far = pair.span(&a, &b, DescentRule::default())?;
+        let span = human_seconds(timed.elapsed().as_secs_f64());
         out!(
-            "  B at x = {:.3}: {} contacts ({collide_us:.0} us; first contact {} in {first_us:.0} us), distance {:.4} ({distance_us:.0} us), span {:.4} ({span_us:.0} us)",
+            "  B at x = {:.3}: {} contacts ({collide}; first contact {} in {first}), distance {:.4} ({distance}), span {:.4} ({span})",
             shift * extent,
             all.pairs.len(),
-            if any.colliding { "found" } else { "none" },
+            if any.is_some() { "found" } else { "none" },
             gap.distance,
             far.span,
         )?;

@@ -90,3 +90,25 @@ pub fn human_bytes(n: u64) -> String {
         format!("{value:.1} {unit}")
     }
 }
+
+/// A number for people: the shortest decimals that read back exactly, in scientific
+/// notation when they would be very long (1e300 prints as `1e300`, not 301 digits).
+pub fn number(x: f64) -> String {
+    let magnitude = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-5..1e15).contains(&magnitude) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// A duration for people, in the unit that keeps it readable (`0.4 µs`, `12.5 ms`).
+pub fn human_seconds(seconds: f64) -> String {
+    if seconds < 1e-3 {
+        format!("{:.1} µs", seconds * 1e6)
+    } else if seconds < 1.0 {
+        format!("{:.2} ms", seconds * 1e3)
+    } else {
+        format!("{seconds:.2} s")
+    }
+}

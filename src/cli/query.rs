@@ -4,7 +4,7 @@ use super::build::{build_with_progress, load_mesh, TreeArgs};
 use super::files::is_obbt;
 use super::poses::PoseArgs;
 use super::print::{self, out};
-use super::Failure;
+use super::{number, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
 use obbtree::format::ObbtFile;
@@ -33,9 +33,13 @@ pub struct QueryInputs {
     /// Print JSON (one object; a batch always prints JSON lines).
     #[arg(long)]
     pub json: bool,
-    /// How mesh inputs are built (ignored for .obbt inputs; a mesh paired with a .obbt file
-    /// is built with that file's volume and precision).
-    #[command(flatten)]
+    /// How mesh inputs are built in memory. They do not apply to .obbt inputs (given with
+    /// two .obbt inputs they are refused), and a mesh paired with a .obbt file is built
+    /// with that file's volume and precision.
+    #[command(
+        flatten,
+        next_help_heading = "Mesh inputs (built in memory; not for .obbt inputs)"
+    )]
     pub tree: TreeArgs,
 }
 
@@ -74,14 +78,14 @@ impl RuleArg {
 /// Example: obbtree collide a.obbt b.obbt --pose-b 1,0,0,0,1,0,0,0,1,0.5,0,0 --pairs
 #[derive(Args, Debug)]
 pub struct CollideArgs {
-    #[command(flatten)]
-    pub inputs: QueryInputs,
     /// Stop at the first contact found (yes/no with one witness pair).
     #[arg(long)]
     pub first: bool,
     /// List the contacting pairs (input-mesh triangle ids).
     #[arg(long)]
     pub pairs: bool,
+    #[command(flatten)]
+    pub inputs: QueryInputs,
 }
 
 /// Compute the separation distance between two posed models, with the closest points.
@@ -93,8 +97,6 @@ pub struct CollideArgs {
 /// Example: obbtree distance a.obbt b.obbt --pose-b 1,0,0,0,1,0,0,0,1,2,0,0 --json
 #[derive(Args, Debug)]
 pub struct DistanceArgs {
-    #[command(flatten)]
-    pub inputs: QueryInputs,
     /// Relative error allowed (>= 0).
     #[arg(
         long,
@@ -114,6 +116,8 @@ pub struct DistanceArgs {
     /// Only decide whether the distance is below T.
     #[arg(long, value_name = "T", allow_negative_numbers = true, conflicts_with_all = ["rel_err", "abs_err"])]
     pub tolerance: Option<f64>,
+    #[command(flatten)]
+    pub inputs: QueryInputs,
 }
 
 /// Compute the span: the largest distance between a point of A and a point of B.
@@ -145,15 +149,35 @@ fn open_input(path: &Path, options: &BuildOptions) -> Result<ObbtFile, Failure> 
 }
 
 fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
-    let mut options = inputs.tree.options();
+    let tree = &inputs.tree;
+    let mut options = tree.options();
+    let trees: Vec<&PathBuf> = [&inputs.a, &inputs.b]
+        .into_iter()
+        .filter(|p| is_tree_input(p))
+        .collect();
+    if let ([_, _], Some(flag)) = (trees.as_slice(), tree.given().first()) {
+        return Err(Failure(format!(
+            "{flag} applies to mesh inputs only, and A and B are both .obbt files"
+        )));
+    }
     // A mesh paired with a tree file is built to match it, so the pair can be queried.
-    for path in [&inputs.a, &inputs.b] {
-        if is_tree_input(path) {
-            let info = ObbtFile::open(path)?.info();
-            options.bv = info.bv;
-            options.precision = info.precision;
-            break;
+    if let Some(path) = trees.first() {
+        let info = ObbtFile::open(path)?.info();
+        let conflict = |flag: &str, given: String, stored: &str| {
+            Failure(format!(
+                "{flag} {given}: {} stores {stored}, and a mesh paired with it is built to match",
+                path.display()
+            ))
+        };
+        if options.bv != info.bv && tree.bv.is_some() {
+            return Err(conflict("--bv", options.bv.name().into(), info.bv.name()));
         }
+        if options.precision != info.precision && tree.precision.is_some() {
+            let given = options.precision.name().into();
+            return Err(conflict("--precision", given, info.precision.name()));
+        }
+        options.bv = info.bv;
+        options.precision = info.precision;
     }
     Ok((
         open_input(&inputs.a, &options)?,
@@ -323,7 +347,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
                     "closer than {t}: yes (triangles {} and {} at {}) ({}) in {seconds:.6} s",
                     w.tri_a,
                     w.tri_b,
-                    w.distance,
+                    number(w.distance),
                     stats_text(&r.stats)
                 ),
                 None => format!(
@@ -345,7 +369,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         );
         let text = format!(
             "distance: {} between triangle {} of A at {:?} and triangle {} of B at {:?} ({}) in {seconds:.6} s",
-            r.distance,
+            number(r.distance),
             r.tri_a,
             r.point_a.as_slice(),
             r.tri_b,
@@ -373,7 +397,7 @@ pub fn span(args: &SpanArgs) -> Result<(), Failure> {
         );
         let text = format!(
             "span: {} between {:?} on A and {:?} on B ({}) in {seconds:.6} s",
-            r.span,
+            number(r.span),
             r.point_a.as_slice(),
             r.point_b.as_slice(),
             stats_text(&r.stats)

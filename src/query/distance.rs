@@ -12,7 +12,8 @@ use nalgebra::Vector3;
 
 /// How to run a distance query.
 ///
-/// With both errors 0 the distance is exact. Otherwise a pair of volumes is skipped once
+/// With both errors 0 the distance is exact (up to a relative 6e-14, the resolution of f64
+/// bounds on far-apart models). Otherwise a pair of volumes is skipped once
 /// its lower bound `lb` satisfies `lb * (1 + rel_err) >= best` or `lb + abs_err >= best`, so
 /// the returned distance `d` and the true distance `d*` satisfy
 /// `d* <= d <= max(d* * (1 + rel_err), d* + abs_err)`; the points always realise `d`.
@@ -71,6 +72,15 @@ pub struct ToleranceResult {
     /// Work done.
     pub stats: Stats,
 }
+
+/// The relative difference below which distances of far-apart models cannot be told apart:
+/// box bounds carry a rounding slack of 64 ε per component of the centre offset (up to
+/// 192 ε of it), so a pair whose bound is within this of the best cannot be shown closer.
+/// Pruning it keeps every answer within this factor of the minimum, far below the
+/// triangle distance's own rounding for any offset near the models, and stops models
+/// 1e300 apart (where every triangle pair is at the same f64 distance) from measuring
+/// every pair.
+const RESOLUTION: f64 = 256.0 * f64::EPSILON;
 
 /// The best pair found so far, in A's frame.
 #[derive(Clone, Copy)]
@@ -133,7 +143,10 @@ impl<B: BoundingVolume> Policy<B> for Distance {
         // enough out overflows every bound to infinity, and the answer is then an infinite
         // distance, not none.
         (self.best.faces.is_none() && self.limit == f64::INFINITY)
-            || (key < self.limit && key * (1.0 + self.rel_err) < best && key + self.abs_err < best)
+            || (key < self.limit
+                && key * (1.0 + self.rel_err) < best
+                && key + self.abs_err < best
+                && key < best * (1.0 - RESOLUTION))
     }
 
     #[inline]
