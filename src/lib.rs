@@ -1,4 +1,62 @@
-//! obbtree: collision queries on triangle meshes with oriented bounding box trees.
+//! Collision, distance and span queries between posed triangle meshes, with the oriented
+//! bounding box trees of Gottschalk's dissertation *Collision Queries using Oriented
+//! Bounding Boxes* (the OBBTree behind RAPID).
+//!
+//! Build a tree once, offline, into one `.obbt` file ([`build`], `obbtree build`); then map
+//! it wherever queries run ([`format::ObbtFile::open`]: constant time for any size, nothing
+//! parsed or rebuilt) and query pairs of posed models ([`query`]).
+//!
+//! # Guide
+//!
+//! ```
+//! use obbtree::build::{build, BuildOptions};
+//! use obbtree::format::ObbtFile;
+//! use obbtree::mesh::TriMesh;
+//! use obbtree::nalgebra::{Isometry3, Vector3};
+//! use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
+//!
+//! // Offline: load a mesh (OBJ or STL) and write its tree.
+//! let mesh = TriMesh::load(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cow.obj").as_ref())?;
+//! let path = std::env::temp_dir().join(format!("guide-{}.obbt", std::process::id()));
+//! build(&mesh, &BuildOptions::default(), None)?.write_atomic(&path)?;
+//!
+//! // In the application: map the file (O(1)), verify it once if it came from elsewhere.
+//! let cow = ObbtFile::open(&path)?;
+//! cow.verify()?;
+//!
+//! // One PairQuery per pair of models: poses per call, scratch kept between calls.
+//! let mut pair = PairQuery::new(&cow, &cow)?;
+//! let here = Pose::identity();
+//! // Poses are f64 rigid motions; nalgebra's types convert (the crate re-exports the
+//! // nalgebra it uses, so the versions always match).
+//! let there = Pose::from_isometry(&Isometry3::translation(0.3, 0.0, 0.0))?;
+//!
+//! // Yes/no per frame: the first contact found, the cheapest collision answer.
+//! assert!(pair.first_contact(&here, &there)?.is_some());
+//! // All contacting triangle pairs (input-mesh ids), when they are needed.
+//! let contacts = pair.collide(&here, &there, &CollideOptions::default())?;
+//! assert!(contacts.pairs.len() > 1);
+//! // Separation distance with the closest points, here between copies 2 units apart.
+//! let apart = Pose::translation(2.0, 0.0, 0.0);
+//! let gap = pair.distance(&here, &apart, &DistanceOptions::default())?;
+//! assert!(gap.distance > 0.9 && gap.distance < 1.1);
+//! assert!(((gap.point_b - gap.point_a).norm() - gap.distance).abs() < 1e-9);
+//! # std::fs::remove_file(&path)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! # Modules
+//!
+//! - [`mesh`]: [`mesh::TriMesh`] and the OBJ / STL loaders;
+//! - [`build`]: the top-down builder and its options;
+//! - [`format`]: the `.obbt` file: open (memory-mapped), verify, write;
+//! - [`query`]: collision, distance (exact, approximate, below a limit, tolerance) and
+//!   span between two posed trees; [`query::PairQuery`] for repeated queries of a pair;
+//! - [`bv`], [`tree`], [`fit`], [`real`]: bounding volumes, the packed tree view, frame
+//!   fitting and stored precision, for tools that look inside a tree.
+//!
+//! The library never panics on data it did not make: damaged files, meshes and poses
+//! give errors (see the README's robustness section).
 #![forbid(unsafe_op_in_unsafe_fn)]
 // The library never panics on data it did not make (files, meshes, poses): outside tests,
 // no unwrap / expect / panic, and every index or slice is checked (`get`) or, where it is in
