@@ -49,7 +49,7 @@
 //!
 //! - [`mesh`]: [`mesh::TriMesh`] and the OBJ / STL loaders;
 //! - [`build`]: the top-down builder and its options;
-//! - [`format`]: the `.obbt` file: open (memory-mapped), verify, write;
+//! - [`format`](mod@format): the `.obbt` file: open (memory-mapped), verify, write;
 //! - [`query`]: collision, distance (exact, approximate, below a limit, tolerance) and
 //!   span between two posed trees; [`query::PairQuery`] for repeated queries of a pair;
 //! - [`bv`], [`tree`], [`fit`], [`real`]: bounding volumes, the packed tree view, frame
