@@ -89,4 +89,5 @@ pub mod format;
 pub mod mesh;
 pub mod query;
 pub mod real;
+pub mod scene;
 pub mod tree;

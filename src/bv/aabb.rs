@@ -33,6 +33,12 @@ impl<R: Real> Aabb<R> {
 
     /// The pair in box A's frame. Model axes are exactly orthonormal, so both setups are
     /// the same and the slack is rounding only.
+    /// Centre, axes (the model's), half-widths and frame error (none), in f64.
+    fn local_box(&self) -> (Vector3<f64>, Matrix3<f64>, Vector3<f64>, f64) {
+        let (c, h) = self.center_half();
+        (c, Matrix3::identity(), h, 0.0)
+    }
+
     #[inline]
     fn pair_with(&self, other: &Self, xf: &Transform, _setup: PairSetup) -> BoxPair {
         let (ca, ha) = self.center_half();

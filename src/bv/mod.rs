@@ -15,7 +15,7 @@ pub use obb::Obb;
 pub use sphere::Sphere;
 
 use crate::real::Real;
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 use pair::Transform;
 use std::fmt::Debug;
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -135,6 +135,12 @@ pub trait BoundingVolume:
     /// `other` (posed as in [`BoundingVolume::overlaps`]).
     fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64;
 
+    /// An axis-aligned box containing this volume once mapped by `p ↦ rotation · p +
+    /// translation` (a model pose): the broad phase of scenes bounds each posed model by
+    /// the world box of its root volume, with no traversal. Conservative: widened for the
+    /// stored frame's error and for rounding.
+    fn world_aabb(&self, rotation: &Matrix3<f64>, translation: &Vector3<f64>) -> Aabb<f64>;
+
     /// Largest distance between two points of the volume (model units).
     fn diameter(&self) -> f64;
     /// Enclosed volume (cubic model units).
@@ -231,4 +237,29 @@ pub(crate) fn listed_vertices<'a>(
 /// Whether all components are finite.
 pub(crate) fn all_finite<R: Real>(values: &[R]) -> bool {
     values.iter().all(|v| v.to_f64().is_finite())
+}
+
+/// The world box of a box volume: centre `center` (model frame), axes the rows of `axes`,
+/// half-widths `half`, mapped by `rotation` and `translation`. Each world extent is
+/// `Σ_i h_i |(R a_i)_k|`; `frame_error` (how far the axes may be from orthonormal) widens
+/// it by that share of the half-widths, and a few ulps of the magnitudes cover rounding.
+pub(crate) fn posed_box_aabb(
+    center: &Vector3<f64>,
+    axes: &Matrix3<f64>,
+    half: &Vector3<f64>,
+    frame_error: f64,
+    rotation: &Matrix3<f64>,
+    translation: &Vector3<f64>,
+) -> Aabb<f64> {
+    let c = rotation * center + translation;
+    // Column i of `world_axes` is axis i in the world.
+    let world_axes = rotation * axes.transpose();
+    let extent = world_axes.abs() * half;
+    let slack = 4.0 * frame_error * half.sum()
+        + 16.0 * f64::EPSILON * (c.abs().max() + extent.max() + translation.abs().max());
+    let reach = extent.add_scalar(slack);
+    Aabb {
+        min: (c - reach).into(),
+        max: (c + reach).into(),
+    }
 }

@@ -81,6 +81,16 @@ impl<R: Real> Obb<R> {
         BoxPair::from_offset(&axes_a, ha, &axes_b, hb, &offset, &xf.rotation, tol)
     }
 
+    /// Centre, axes (rows), half-widths and the frame's orthonormality tolerance, in f64.
+    fn local_box(&self) -> (Vector3<f64>, Matrix3<f64>, Vector3<f64>, f64) {
+        (
+            Vector3::from(self.center_f64()),
+            self.axes_matrix(),
+            Vector3::from(self.half_f64()),
+            axis_tolerance(R::PRECISION),
+        )
+    }
+
     /// The axes widened to f64, one per row.
     pub fn axes_f64(&self) -> [[f64; 3]; 3] {
         self.axes.map(|a| point_to_f64(&a))

@@ -305,8 +305,9 @@ pub(crate) enum PairSetup {
 }
 
 /// The pair tests and size measures shared by the two box volumes, written once: both types
-/// provide `pair_with(&self, &Self, &Transform, PairSetup) -> BoxPair` and
-/// `half_f64(&self) -> [f64; 3]`.
+/// provide `pair_with(&self, &Self, &Transform, PairSetup) -> BoxPair`,
+/// `half_f64(&self) -> [f64; 3]` and `local_box(&self)` (centre, axes as rows, half-widths,
+/// frame error, all f64 in the model frame).
 macro_rules! box_pair_methods {
     () => {
         #[inline]
@@ -326,6 +327,15 @@ macro_rules! box_pair_methods {
         fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
             self.pair_with(other, xf, $crate::bv::pair::PairSetup::Metric)
                 .max_distance()
+        }
+
+        fn world_aabb(
+            &self,
+            rotation: &nalgebra::Matrix3<f64>,
+            translation: &nalgebra::Vector3<f64>,
+        ) -> $crate::bv::Aabb<f64> {
+            let (center, axes, half, frame_error) = self.local_box();
+            $crate::bv::posed_box_aabb(&center, &axes, &half, frame_error, rotation, translation)
         }
 
         fn diameter(&self) -> f64 {

@@ -3,8 +3,8 @@
 use super::obb::dot;
 use super::pair::Transform;
 use super::{
-    all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
-    BvKind,
+    all_finite, face_vertices, l1, listed_vertices, projection_slack, Aabb, BoundingVolume,
+    BvDefect, BvKind,
 };
 use crate::arr3;
 use crate::real::{point_to_f64, Real};
@@ -132,6 +132,16 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     #[inline]
     fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
         self.center_distance(other, xf) + self.radius.to_f64() + other.radius.to_f64()
+    }
+
+    fn world_aabb(&self, rotation: &Matrix3<f64>, translation: &Vector3<f64>) -> Aabb<f64> {
+        let c = rotation * Vector3::from(point_to_f64(&self.center)) + translation;
+        let r = self.radius.to_f64();
+        let r = r + 16.0 * f64::EPSILON * (c.abs().max() + r + translation.abs().max());
+        Aabb {
+            min: c.add_scalar(-r).into(),
+            max: c.add_scalar(r).into(),
+        }
     }
 
     fn diameter(&self) -> f64 {

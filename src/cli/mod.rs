@@ -8,6 +8,7 @@ mod info;
 mod poses;
 mod print;
 mod query;
+mod scene;
 mod verify;
 
 use clap::{Parser, Subcommand};
@@ -38,6 +39,7 @@ enum Command {
     Collide(query::CollideArgs),
     Distance(query::DistanceArgs),
     Span(query::SpanArgs),
+    Scene(scene::SceneArgs),
     Demo(demo::DemoArgs),
 }
 
@@ -62,6 +64,7 @@ pub fn main() -> ExitCode {
         Command::Collide(args) => query::collide(&args),
         Command::Distance(args) => query::distance(&args),
         Command::Span(args) => query::span(&args),
+        Command::Scene(args) => scene::run(&args),
         Command::Demo(args) => demo::run(&args),
     };
     match outcome {

@@ -1,0 +1,120 @@
+//! Frames as JSON Lines, streamed: `{"poses": {"link2": [12 numbers], ...}}` per line.
+
+use super::error::SceneError;
+use super::report::ObjectId;
+use super::simulate::{Frame, Scene};
+use crate::query::PoseFormat;
+use rustc_hash::FxHashMap;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::io::{BufRead, Read};
+
+/// The longest frame line read (bytes): a frame moving 10,000 objects is about 2.5 MB.
+pub const MAX_FRAME_LINE: u64 = 64 << 20;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameLine {
+    poses: BTreeMap<String, Vec<f64>>,
+}
+
+/// Reads frames one line at a time from any reader, so a million frames are never held in
+/// memory. The frame number is the line index from 0; every line must be a frame (a
+/// frame that moves nothing is `{"poses": {}}`).
+pub struct FrameReader<R> {
+    input: R,
+    source: String,
+    line: usize,
+    bytes: u64,
+    ids: FxHashMap<String, ObjectId>,
+    format: PoseFormat,
+    repair: bool,
+    buffer: Vec<u8>,
+}
+
+impl<R: BufRead> FrameReader<R> {
+    /// Frames for `scene` from `input` (named `source` in errors), poses in `format`,
+    /// repaired to the nearest rotation when `repair` (see [`PoseFormat::parse`]).
+    pub fn new(
+        input: R,
+        source: &str,
+        scene: &Scene,
+        format: PoseFormat,
+        repair: bool,
+    ) -> FrameReader<R> {
+        FrameReader {
+            input,
+            source: source.to_owned(),
+            line: 0,
+            bytes: 0,
+            ids: scene
+                .names()
+                .iter()
+                .enumerate()
+                .map(|(i, n)| (n.clone(), i))
+                .collect(),
+            format,
+            repair,
+            buffer: Vec::new(),
+        }
+    }
+
+    /// Bytes read so far (for progress).
+    pub fn bytes_read(&self) -> u64 {
+        self.bytes
+    }
+
+    fn error(&self, message: impl Into<String>) -> SceneError {
+        SceneError::new(&self.source, message).at_line(self.line)
+    }
+
+    /// The next frame, `None` at the end of the input.
+    pub fn next_frame(&mut self) -> Option<Result<Frame, SceneError>> {
+        self.buffer.clear();
+        let read = (&mut self.input)
+            .take(MAX_FRAME_LINE + 1)
+            .read_until(b'\n', &mut self.buffer);
+        self.line += 1;
+        match read {
+            Ok(0) => return None,
+            Ok(n) => self.bytes += n as u64,
+            Err(e) => return Some(Err(self.error(format!("cannot read: {e}")))),
+        }
+        if self.buffer.len() as u64 > MAX_FRAME_LINE {
+            let m = format!("a frame line is longer than {MAX_FRAME_LINE} bytes");
+            return Some(Err(self.error(m)));
+        }
+        Some(self.parse())
+    }
+
+    fn parse(&self) -> Result<Frame, SceneError> {
+        let text = self.buffer.strip_suffix(b"\n").unwrap_or(&self.buffer);
+        let text = text.strip_suffix(b"\r").unwrap_or(text);
+        if text.iter().all(u8::is_ascii_whitespace) {
+            return Err(self.error(r#"empty line (a frame that moves nothing is {"poses": {}})"#));
+        }
+        let line: FrameLine =
+            serde_json::from_slice(text).map_err(|e| self.error(format!("not a frame: {e}")))?;
+        let mut frame = Frame::new();
+        for (name, values) in &line.poses {
+            let field = format!("poses.{name}");
+            let Some(&id) = self.ids.get(name) else {
+                let m = format!("no object named {name:?} in the scene");
+                return Err(self.error(m).in_field(field));
+            };
+            let parsed = self
+                .format
+                .parse(values, self.repair)
+                .map_err(|e| self.error(e.to_string()).in_field(field))?;
+            frame.set(id, parsed.pose);
+        }
+        Ok(frame)
+    }
+}
+
+impl<R: BufRead> Iterator for FrameReader<R> {
+    type Item = Result<Frame, SceneError>;
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_frame()
+    }
+}

@@ -1,0 +1,284 @@
+//! What a frame answers, what changed, and what the whole run cost; with their JSON.
+
+use serde_json::{json, Value};
+
+/// An object's index in scene-file order.
+pub type ObjectId = usize;
+
+/// The non-empty answer of one pair (an empty one, such as "not in contact", is not
+/// listed).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Answer {
+    /// `contact`: the two touch.
+    Contact,
+    /// `contacts`: every contacting triangle pair (input-mesh ids of A's and B's
+    /// triangles), sorted.
+    Contacts(Vec<(u32, u32)>),
+    /// `clearance`: the two come closer than the clearance; a triangle pair that does
+    /// (not necessarily the closest).
+    Closer {
+        /// Triangle of the pair's first object.
+        tri_a: u32,
+        /// Triangle of the pair's second object.
+        tri_b: u32,
+        /// Their distance, below the clearance.
+        distance: f64,
+    },
+    /// `distance`: the distance (within the rule's `rel_err`) and a closest pair.
+    Distance {
+        /// The distance, world units.
+        distance: f64,
+        /// Triangle of the first object.
+        tri_a: u32,
+        /// Triangle of the second object.
+        tri_b: u32,
+    },
+    /// `distance` with `max_distance`: at least that far apart.
+    Far,
+    /// `span`: the largest distance between the two.
+    Span(f64),
+}
+
+impl Answer {
+    /// The effect this answers, by its scene-file name.
+    pub fn effect_name(&self) -> &'static str {
+        match self {
+            Answer::Contact => "contact",
+            Answer::Contacts(_) => "contacts",
+            Answer::Closer { .. } => "clearance",
+            Answer::Distance { .. } | Answer::Far => "distance",
+            Answer::Span(_) => "span",
+        }
+    }
+
+    /// Whether this answer means "touching" (contact, contacts) or "too close"
+    /// (clearance): the states whose changes are events.
+    pub(crate) fn alarm(answer: Option<&Answer>) -> bool {
+        matches!(
+            answer,
+            Some(Answer::Contact | Answer::Contacts(_) | Answer::Closer { .. })
+        )
+    }
+
+    /// The answer's own JSON fields.
+    fn fields(&self, out: &mut serde_json::Map<String, Value>) {
+        let mut put = |k: &str, v: Value| {
+            out.insert(k.to_owned(), v);
+        };
+        match self {
+            Answer::Contact => put("contact", json!(true)),
+            Answer::Contacts(pairs) => {
+                put("contacts", json!(pairs.len()));
+                put(
+                    "pairs",
+                    json!(pairs.iter().map(|&(a, b)| [a, b]).collect::<Vec<_>>()),
+                );
+            }
+            Answer::Closer {
+                tri_a,
+                tri_b,
+                distance,
+            } => {
+                put("closer", json!(true));
+                put(
+                    "witness",
+                    json!({"tri_a": tri_a, "tri_b": tri_b, "distance": distance}),
+                );
+            }
+            Answer::Distance {
+                distance,
+                tri_a,
+                tri_b,
+            } => {
+                put("distance", json!(distance));
+                put("tri_a", json!(tri_a));
+                put("tri_b", json!(tri_b));
+            }
+            Answer::Far => put("far", json!(true)),
+            Answer::Span(span) => put("span", json!(span)),
+        }
+    }
+}
+
+/// One listed pair of a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairReport {
+    /// The first object (earlier in the scene file).
+    pub a: ObjectId,
+    /// The second object.
+    pub b: ObjectId,
+    /// Its answer.
+    pub answer: Answer,
+}
+
+/// A change of a pair's state since the previous frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EventKind {
+    /// A `contact` or `contacts` pair began to touch.
+    ContactStarted,
+    /// It stopped touching.
+    ContactEnded,
+    /// A `clearance` pair came closer than its clearance.
+    ClearanceViolated,
+    /// It is no longer closer than its clearance.
+    ClearanceRestored,
+}
+
+impl EventKind {
+    /// The JSON name: `contact_started`, `contact_ended`, `clearance_violated`,
+    /// `clearance_restored`.
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::ContactStarted => "contact_started",
+            EventKind::ContactEnded => "contact_ended",
+            EventKind::ClearanceViolated => "clearance_violated",
+            EventKind::ClearanceRestored => "clearance_restored",
+        }
+    }
+
+    /// The event of a pair whose alarm state (see [`Answer`]) went to `now`.
+    pub(crate) fn of(clearance: bool, now: bool) -> EventKind {
+        match (clearance, now) {
+            (false, true) => EventKind::ContactStarted,
+            (false, false) => EventKind::ContactEnded,
+            (true, true) => EventKind::ClearanceViolated,
+            (true, false) => EventKind::ClearanceRestored,
+        }
+    }
+}
+
+/// An event of a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Event {
+    /// The first object.
+    pub a: ObjectId,
+    /// The second object.
+    pub b: ObjectId,
+    /// What happened.
+    pub kind: EventKind,
+}
+
+/// Everything a frame answers.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameReport {
+    /// The frame number (the frames' line index, from 0).
+    pub frame: u64,
+    /// Every pair with an effect whose answer is not empty, sorted by `(a, b)`.
+    pub pairs: Vec<PairReport>,
+    /// The changes since the previous frame, sorted by `(a, b)`.
+    pub events: Vec<Event>,
+}
+
+impl FrameReport {
+    /// `{"frame": k, "pairs": [...], "events": [...]}`, objects by `names`.
+    pub fn to_json(&self, names: &[String]) -> Value {
+        let name = |i: ObjectId| names.get(i).map(String::as_str).unwrap_or("?");
+        let pairs: Vec<Value> = self
+            .pairs
+            .iter()
+            .map(|p| {
+                let mut object = serde_json::Map::new();
+                object.insert("a".into(), json!(name(p.a)));
+                object.insert("b".into(), json!(name(p.b)));
+                object.insert("effect".into(), json!(p.answer.effect_name()));
+                p.answer.fields(&mut object);
+                Value::Object(object)
+            })
+            .collect();
+        let events: Vec<Value> = self
+            .events
+            .iter()
+            .map(|e| json!({"a": name(e.a), "b": name(e.b), "event": e.kind.name()}))
+            .collect();
+        json!({"frame": self.frame, "pairs": pairs, "events": events})
+    }
+}
+
+/// Narrow-phase queries run, by the effect they answered.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NarrowCounts {
+    /// First-contact queries (`contact`).
+    pub contact: u64,
+    /// All-pairs collision queries (`contacts`).
+    pub contacts: u64,
+    /// Tolerance queries (`clearance`).
+    pub clearance: u64,
+    /// Distance queries (`distance`).
+    pub distance: u64,
+    /// Span queries (`span`).
+    pub span: u64,
+}
+
+impl NarrowCounts {
+    /// All queries.
+    pub fn total(&self) -> u64 {
+        self.contact + self.contacts + self.clearance + self.distance + self.span
+    }
+}
+
+/// What a run of frames cost, and what the scheduler skipped.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Frames stepped.
+    pub frames: u64,
+    /// Objects in the scene.
+    pub objects: u64,
+    /// Pairs of distinct objects whose effect is not `none`.
+    pub pairs_with_effect: u64,
+    /// Pair-frames the broad phase proved empty (no contact, not closer, far) without a
+    /// narrow query, summed over frames.
+    pub culled: u64,
+    /// Pair-frames answered by reusing the previous answer (neither object moved).
+    pub reused: u64,
+    /// Narrow-phase queries run.
+    pub narrow: NarrowCounts,
+    /// Narrow queries that stopped early: a first contact found, a clearance violated,
+    /// or a limited distance found far.
+    pub early_exits: u64,
+    /// Distance queries started from the previous frame's witness pair.
+    pub warm_starts: u64,
+    /// Triangle pair tests of all narrow queries.
+    pub triangle_tests: u64,
+    /// Bounding-volume pair tests of all narrow queries.
+    pub box_tests: u64,
+    /// Wall time spent in frames (seconds).
+    pub seconds: f64,
+}
+
+impl Summary {
+    /// Frames per second of wall time.
+    pub fn frames_per_second(&self) -> f64 {
+        if self.seconds > 0.0 {
+            self.frames as f64 / self.seconds
+        } else {
+            0.0
+        }
+    }
+
+    /// `{"summary": {...}}`; `mode` is `fast` or `naive`.
+    pub fn to_json(&self, mode: &str) -> Value {
+        let n = &self.narrow;
+        json!({"summary": {
+            "mode": mode,
+            "frames": self.frames,
+            "objects": self.objects,
+            "pairs_with_effect": self.pairs_with_effect,
+            "culled": self.culled,
+            "reused": self.reused,
+            "narrow": {
+                "contact": n.contact,
+                "contacts": n.contacts,
+                "clearance": n.clearance,
+                "distance": n.distance,
+                "span": n.span,
+                "total": n.total(),
+            },
+            "early_exits": self.early_exits,
+            "warm_starts": self.warm_starts,
+            "triangle_tests": self.triangle_tests,
+            "box_tests": self.box_tests,
+            "seconds": self.seconds,
+            "frames_per_second": self.frames_per_second(),
+        }})
+    }
+}

@@ -1,0 +1,152 @@
+//! Who gets what: the effects a pair of objects can ask for, the rules that assign them,
+//! and the effect of any pair, looked up in constant time.
+
+/// What a pair of objects asks for, every frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Effect {
+    /// Nothing: the pair is never tested (adjacent arm links, parts of one fixture).
+    None,
+    /// Whether the two touch: answered by the first contact found.
+    Contact,
+    /// Every contacting triangle pair.
+    Contacts,
+    /// Whether the two come closer than `clearance` (world units), with a witness pair.
+    Clearance {
+        /// The clearance, > 0.
+        clearance: f64,
+    },
+    /// The separation distance.
+    Distance {
+        /// Relative error allowed (0: exact).
+        rel_err: f64,
+        /// Beyond this distance the answer is "far" and no exact value is computed.
+        max_distance: Option<f64>,
+    },
+    /// The span: the largest distance between the two.
+    Span,
+}
+
+/// How near two objects must be for an effect to need the narrow phase.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Reach {
+    /// Never (effect `none`).
+    Never,
+    /// When their surfaces are closer than this (0: touching).
+    Within(f64),
+    /// Every frame, whatever the distance (a distance without a limit, a span).
+    Always,
+}
+
+impl Effect {
+    /// The scene-file name: `none`, `contact`, `contacts`, `clearance`, `distance`, `span`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Effect::None => "none",
+            Effect::Contact => "contact",
+            Effect::Contacts => "contacts",
+            Effect::Clearance { .. } => "clearance",
+            Effect::Distance { .. } => "distance",
+            Effect::Span => "span",
+        }
+    }
+
+    pub(crate) fn reach(&self) -> Reach {
+        match *self {
+            Effect::None => Reach::Never,
+            Effect::Contact | Effect::Contacts => Reach::Within(0.0),
+            Effect::Clearance { clearance } => Reach::Within(clearance),
+            Effect::Distance {
+                max_distance: Some(limit),
+                ..
+            } => Reach::Within(limit),
+            Effect::Distance { .. } | Effect::Span => Reach::Always,
+        }
+    }
+}
+
+/// For every object, which rules match it on side `a` and on side `b`, as bit sets; the
+/// effect of a pair is the last rule matching it in either order.
+#[derive(Clone, Debug)]
+pub(crate) struct RuleTable {
+    effects: Vec<Effect>,
+    /// 64-bit words per object row.
+    words: usize,
+    side_a: Vec<u64>,
+    side_b: Vec<u64>,
+}
+
+impl RuleTable {
+    /// The table of `effects` (one per rule, in order) for `objects` objects, where
+    /// `matches(rule, side_b, object)` says whether a rule's side matches an object.
+    pub(crate) fn new(
+        effects: Vec<Effect>,
+        objects: usize,
+        matches: impl Fn(usize, bool, usize) -> bool,
+    ) -> RuleTable {
+        let words = effects.len().div_ceil(64).max(1);
+        let mut side_a = vec![0u64; objects.saturating_mul(words)];
+        let mut side_b = side_a.clone();
+        for (rows, side) in [(&mut side_a, false), (&mut side_b, true)] {
+            for (object, row) in rows.chunks_exact_mut(words).enumerate() {
+                for (rule, _) in effects.iter().enumerate() {
+                    if matches(rule, side, object) {
+                        if let Some(word) = row.get_mut(rule / 64) {
+                            *word |= 1 << (rule % 64);
+                        }
+                    }
+                }
+            }
+        }
+        RuleTable {
+            effects,
+            words,
+            side_a,
+            side_b,
+        }
+    }
+
+    fn row<'t>(&self, side: &'t [u64], object: usize) -> &'t [u64] {
+        let start = object.saturating_mul(self.words);
+        side.get(start..start.saturating_add(self.words))
+            .unwrap_or(&[])
+    }
+
+    /// The effect of the pair `(i, j)`: the last rule whose sides match it in either order,
+    /// `none` without one (and for an object with itself).
+    pub(crate) fn effect(&self, i: usize, j: usize) -> Effect {
+        if i == j {
+            return Effect::None;
+        }
+        let (ai, bi) = (self.row(&self.side_a, i), self.row(&self.side_b, i));
+        let (aj, bj) = (self.row(&self.side_a, j), self.row(&self.side_b, j));
+        for w in (0..self.words).rev() {
+            let word = |row: &[u64]| row.get(w).copied().unwrap_or(0);
+            let hits = (word(ai) & word(bj)) | (word(aj) & word(bi));
+            if hits != 0 {
+                let rule = w * 64 + 63 - hits.leading_zeros() as usize;
+                return self.effects.get(rule).copied().unwrap_or(Effect::None);
+            }
+        }
+        Effect::None
+    }
+
+    /// The largest distance any rule matching `object` (either side) reaches within: how
+    /// far its broad-phase box must be inflated, in total, for those rules.
+    pub(crate) fn reach_of(&self, object: usize) -> f64 {
+        let (a, b) = (
+            self.row(&self.side_a, object),
+            self.row(&self.side_b, object),
+        );
+        let mut reach = 0.0f64;
+        for (rule, effect) in self.effects.iter().enumerate() {
+            let bit = |row: &[u64]| {
+                row.get(rule / 64)
+                    .is_some_and(|w| w >> (rule % 64) & 1 == 1)
+            };
+            if let (true, Reach::Within(d)) = (bit(a) || bit(b), effect.reach()) {
+                reach = reach.max(d);
+            }
+        }
+        reach
+    }
+}
