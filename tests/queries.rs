@@ -217,23 +217,34 @@ fn check_all(
         prop_assert!(first.is_none_or(|p| brute.pairs.contains(&p)));
         let exact = DistanceOptions::default();
         let scale = 1.0 + brute.min_distance;
-        for limit in [brute.min_distance * 0.5, brute.min_distance * 1.5 + 1e-9] {
-            let (r, _) = pair.distance_below(pose_a, pose_b, &exact, limit).unwrap();
-            match r {
-                Some(r) => {
-                    prop_assert!(brute.min_distance < limit);
-                    prop_assert!((r.distance - brute.min_distance).abs() <= 1e-9 * scale);
-                }
-                None => prop_assert!(brute.min_distance >= limit - 1e-9 * scale),
-            }
-        }
-        let cold = pair.distance(pose_a, pose_b, &exact).unwrap();
         let moved = Pose::new(
             *pose_b.rotation(),
             pose_b.translation_vector() + Vector3::new(0.3, -0.2, 0.1),
         )
         .unwrap();
         let elsewhere = pair.distance(pose_a, &moved, &exact).unwrap().witness;
+        // Limits, also with an error allowance and a warm start from another pose (whose
+        // pair may lie beyond the limit: the allowance must not then hide closer pairs).
+        let approximate = DistanceOptions {
+            rel_err: 0.3,
+            warm_start: Some(elsewhere),
+            ..DistanceOptions::default()
+        };
+        let limits = [0.5, 1.05, 1.5].map(|f| brute.min_distance * f + 1e-9);
+        for limit in limits {
+            for (options, rel) in [(&exact, 0.0), (&approximate, 0.3)] {
+                let (r, _) = pair.distance_below(pose_a, pose_b, options, limit).unwrap();
+                match r {
+                    Some(r) => {
+                        prop_assert!(brute.min_distance < limit);
+                        prop_assert!(r.distance >= brute.min_distance - 1e-9 * scale);
+                        prop_assert!(r.distance <= brute.min_distance * (1.0 + rel) + 1e-9 * scale);
+                    }
+                    None => prop_assert!(brute.min_distance >= limit - 1e-9 * scale),
+                }
+            }
+        }
+        let cold = pair.distance(pose_a, pose_b, &exact).unwrap();
         for start in [cold.witness, elsewhere] {
             let warm = DistanceOptions {
                 warm_start: Some(start),

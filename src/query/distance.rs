@@ -142,11 +142,20 @@ impl<B: BoundingVolume> Policy<B> for Distance {
         // Until a first pair is measured without a limit nothing is pruned: a pose far
         // enough out overflows every bound to infinity, and the answer is then an infinite
         // distance, not none.
-        (self.best.faces.is_none() && self.limit == f64::INFINITY)
-            || (key < self.limit
-                && key * (1.0 + self.rel_err) < best
-                && key + self.abs_err < best
-                && key < best * (1.0 - RESOLUTION))
+        if self.best.faces.is_none() && self.limit == f64::INFINITY {
+            return true;
+        }
+        if !(key < self.limit) {
+            return false;
+        }
+        // No pair below the limit yet (a warm start beyond it): only the limit prunes, or
+        // the error allowance could hide the pairs below it.
+        if !(best < self.limit) {
+            return true;
+        }
+        key * (1.0 + self.rel_err) < best
+            && key + self.abs_err < best
+            && key < best * (1.0 - RESOLUTION)
     }
 
     #[inline]

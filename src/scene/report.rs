@@ -194,6 +194,67 @@ impl FrameReport {
     }
 }
 
+impl FrameReport {
+    /// How this report (from the fast path) departs from `reference` (the naive path's
+    /// report of the same frame), or `None` when it agrees: the same events and the same
+    /// pairs with the same answers, except that witnesses may differ where several are
+    /// equally right and distances may differ by rounding (1e-9 relative) or, for a rule
+    /// with `rel_err`, within it. `effect` gives each pair's effect.
+    pub fn disagreement(
+        &self,
+        reference: &FrameReport,
+        effect: impl Fn(ObjectId, ObjectId) -> super::Effect,
+    ) -> Option<String> {
+        let frame = self.frame;
+        if self.events != reference.events {
+            return Some(format!(
+                "frame {frame}: events {:?}, reference {:?}",
+                self.events, reference.events
+            ));
+        }
+        if self.pairs.len() != reference.pairs.len() {
+            let ids = |r: &FrameReport| r.pairs.iter().map(|p| (p.a, p.b)).collect::<Vec<_>>();
+            return Some(format!(
+                "frame {frame}: pairs {:?}, reference {:?}",
+                ids(self),
+                ids(reference)
+            ));
+        }
+        let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + y.abs());
+        for (p, q) in self.pairs.iter().zip(&reference.pairs) {
+            let (rel_err, clearance) = match effect(p.a, p.b) {
+                super::Effect::Distance { rel_err, .. } => (rel_err, f64::INFINITY),
+                super::Effect::Clearance { clearance } => (0.0, clearance),
+                _ => (0.0, f64::INFINITY),
+            };
+            let agree = (p.a, p.b) == (q.a, q.b)
+                && match (&p.answer, &q.answer) {
+                    (Answer::Closer { distance: x, .. }, Answer::Closer { distance: y, .. }) => {
+                        // Any pair closer than the clearance is a right witness.
+                        *x < clearance && *y < clearance
+                    }
+                    (
+                        Answer::Distance { distance: x, .. },
+                        Answer::Distance { distance: y, .. },
+                    ) => {
+                        close(*x, *y)
+                            || (*x >= y - 1e-9 * (1.0 + y)
+                                && *x <= y * (1.0 + rel_err) + 1e-9 * (1.0 + y))
+                    }
+                    (Answer::Span(x), Answer::Span(y)) => close(*x, *y),
+                    (x, y) => x == y,
+                };
+            if !agree {
+                return Some(format!(
+                    "frame {frame}: pair ({}, {}) answers {:?}, reference ({}, {}) {:?}",
+                    p.a, p.b, p.answer, q.a, q.b, q.answer
+                ));
+            }
+        }
+        None
+    }
+}
+
 /// Narrow-phase queries run, by the effect they answered.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NarrowCounts {
