@@ -145,13 +145,13 @@ impl<B: BoundingVolume> Policy<B> for Distance {
         if self.best.faces.is_none() && self.limit == f64::INFINITY {
             return true;
         }
-        if !(key < self.limit) {
-            return false;
-        }
+        // (NaN keys and bests compare false: a damaged file's pair is pruned.)
+        let within_limit = key < self.limit;
         // No pair below the limit yet (a warm start beyond it): only the limit prunes, or
         // the error allowance could hide the pairs below it.
-        if !(best < self.limit) {
-            return true;
+        let found = best < self.limit;
+        if !within_limit || !found {
+            return within_limit;
         }
         key * (1.0 + self.rel_err) < best
             && key + self.abs_err < best
