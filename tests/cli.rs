@@ -2,41 +2,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn obbtree(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_obbtree"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("obbtree-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn cow() -> String {
-    concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cow.obj").to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Exit 1 with exactly one line on stderr that contains `needle`.
-fn assert_bad_input(o: &Output, needle: &str) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "one line expected: {err}"
-    );
-    assert!(err.contains(needle), "{needle:?} not in {err:?}");
-}
+use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
+use std::path::Path;
+use std::process::Command;
 
 fn build(out: &Path, extra: &[&str]) {
     let mut args = vec!["build", &cow(), "-o", out.to_str().unwrap(), "--quiet"]

@@ -1,6 +1,7 @@
 //! Meshes generated in code, shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod cli;
 pub mod mutate;
 pub mod seal;
 

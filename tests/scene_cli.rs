@@ -1,0 +1,312 @@
+//! `obbtree scene`: the shipped robot cell, its precomputed assets, and scenes and frames
+//! that are wrong in every way the issue lists, each refused with one line naming the
+//! file, the line and the field.
+
+mod common;
+
+use common::cli::{assert_bad_input, obbtree, scratch, stderr};
+use obbtree::build::{build, BuildOptions};
+use obbtree::mesh::TriMesh;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn shipped(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/scenes")
+        .join(name)
+}
+
+/// The shipped trees are what the builder makes of their meshes today, byte for byte:
+/// the assets an app ships are reproducible from the repository.
+#[test]
+fn shipped_assets_rebuild_to_the_committed_bytes() {
+    let mut checked = 0;
+    for entry in std::fs::read_dir(shipped("")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("obbt") {
+            continue;
+        }
+        let stem = path.file_stem().unwrap().to_str().unwrap();
+        // The part is the bundled cow.
+        let source = match stem {
+            "cow" => shipped("../cow.obj"),
+            _ => path.with_extension("obj"),
+        };
+        let mesh = TriMesh::load(&source).unwrap();
+        let rebuilt = build(&mesh, &BuildOptions::default(), None).unwrap();
+        let committed = std::fs::read(&path).unwrap();
+        assert!(
+            rebuilt.bytes() == committed.as_slice(),
+            "{}",
+            path.display()
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 9);
+}
+
+fn json_lines(stdout: &[u8]) -> Vec<Value> {
+    String::from_utf8_lossy(stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// Witness fields may differ between the fast path and the reference; distances to
+/// rounding.
+fn comparable(mut frame: Value) -> Value {
+    for pair in frame["pairs"].as_array_mut().unwrap() {
+        let pair = pair.as_object_mut().unwrap();
+        for key in ["witness", "tri_a", "tri_b"] {
+            pair.remove(key);
+        }
+        for key in ["distance", "span"] {
+            if let Some(v) = pair.get_mut(key) {
+                *v = serde_json::json!((v.as_f64().unwrap() * 1e9).round() / 1e9);
+            }
+        }
+    }
+    frame
+}
+
+#[test]
+fn the_shipped_cell_runs_and_agrees_with_the_reference() {
+    let scene = shipped("cell.toml");
+    let s = scene.to_str().unwrap();
+    let fast = obbtree(&["scene", s, "--json"]);
+    assert!(fast.status.success(), "{}", stderr(&fast));
+    let naive = obbtree(&["scene", s, "--json", "--naive"]);
+    assert!(naive.status.success(), "{}", stderr(&naive));
+    let (fast, naive) = (json_lines(&fast.stdout), json_lines(&naive.stdout));
+    assert_eq!(fast.len(), 241);
+    assert_eq!(naive.len(), 241);
+    for (k, (f, n)) in fast.iter().zip(&naive).take(240).enumerate() {
+        assert_eq!(f["frame"], k);
+        assert_eq!(comparable(f.clone()), comparable(n.clone()), "frame {k}");
+    }
+    let (fs, ns) = (&fast[240]["summary"], &naive[240]["summary"]);
+    assert_eq!(fs["frames"], 240);
+    assert_eq!(fs["objects"], 9);
+    assert!(fs["culled"].as_u64().unwrap() > 0 && fs["reused"].as_u64().unwrap() > 0);
+    assert!(fs["narrow"]["total"].as_u64() < ns["narrow"]["total"].as_u64());
+    // The story the cell tells: the gripper grasps the part, the arm passes the fence.
+    let events: Vec<String> = fast
+        .iter()
+        .flat_map(|f| f["events"].as_array().cloned().unwrap_or_default())
+        .map(|e| format!("{} {} {}", e["a"], e["b"], e["event"]).replace('"', ""))
+        .collect();
+    for expected in [
+        "gripper part contact_started",
+        "gripper part contact_ended",
+        "gripper fence clearance_violated",
+        "table part contact_started",
+    ] {
+        assert!(
+            events.iter().any(|e| e == expected),
+            "{expected}: {events:?}"
+        );
+    }
+    // Text mode: events and the summary table; frames from standard input work too.
+    let text = obbtree(&["scene", s]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("gripper / part: contact started"), "{text}");
+    assert!(text.contains("summary (fast)"), "{text}");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_obbtree"))
+        .args(["scene", s, "--frames", "-", "--json"])
+        .stdin(std::fs::File::open(shipped("cell.jsonl")).unwrap())
+        .output()
+        .unwrap();
+    assert!(child.status.success());
+    let piped = json_lines(&std::mem::take(&mut child.stdout));
+    assert_eq!(piped.len(), 241);
+    assert_eq!(
+        comparable(piped[117].clone()),
+        comparable(fast[117].clone())
+    );
+}
+
+const CUBE_OBJ: &str = "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\n\
+v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv -0.5 0.5 0.5\nv 0.5 0.5 0.5\n\
+f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n";
+
+/// A scene directory with a cube mesh, an OBB tree of it and an AABB tree of it.
+fn scene_dir(name: &str) -> PathBuf {
+    let dir = scratch(name);
+    std::fs::write(dir.join("cube.obj"), CUBE_OBJ).unwrap();
+    let obj = dir.join("cube.obj");
+    for (out, bv) in [("cube.obbt", "obb"), ("cube-aabb.obbt", "aabb")] {
+        let o = obbtree(&[
+            "build",
+            obj.to_str().unwrap(),
+            "-o",
+            dir.join(out).to_str().unwrap(),
+            "--bv",
+            bv,
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    std::fs::write(dir.join("corrupt.obbt"), b"\x89OBT\r\n\x1a\nnot really").unwrap();
+    dir
+}
+
+const GOOD: &str = r#"[[object]]
+name = "a"
+asset = "cube.obbt"
+groups = ["g"]
+
+[[object]]
+name = "b"
+asset = "cube.obj"
+pose = [1,0,0, 0,1,0, 0,0,1, 3,0,0]
+
+[[rule]]
+a = "a"
+b = "g"
+effect = "none"
+
+[[rule]]
+a = "*"
+b = "*"
+effect = "clearance"
+clearance = 0.5
+"#;
+
+/// Writes `text` as a scene and runs it (with `frames` as its frames when given).
+fn run(dir: &Path, text: &str, frames: Option<&str>) -> std::process::Output {
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let mut args = vec![
+        "scene".to_string(),
+        scene.display().to_string(),
+        "--json".into(),
+    ];
+    if let Some(f) = frames {
+        let path = dir.join("frames.jsonl");
+        std::fs::write(&path, f).unwrap();
+        args.extend(["--frames".into(), path.display().to_string()]);
+    }
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    obbtree(&refs)
+}
+
+#[test]
+fn a_good_scene_from_a_mesh_and_a_tree_runs() {
+    let dir = scene_dir("good");
+    let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.2,0,0]}}\n{\"poses\": {}}\n";
+    let o = run(&dir, GOOD, Some(frames));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines = json_lines(&o.stdout);
+    assert_eq!(lines.len(), 3);
+    // Frame 0: 0.2 apart, closer than 0.5; frame 1 reuses it.
+    assert_eq!(lines[0]["events"][0]["event"], "clearance_violated");
+    assert_eq!(lines[1]["pairs"], lines[0]["pairs"]);
+    assert_eq!(lines[2]["summary"]["reused"], 1);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_scenes_are_one_line_naming_file_line_and_field() {
+    let dir = scene_dir("bad");
+    let cases: Vec<(String, &str)> = vec![
+        (
+            GOOD.replace("b = \"g\"", "b = \"robto\""),
+            "scene.toml:13: rule 1, field b: no object or group named \"robto\"",
+        ),
+        (
+            GOOD.replace("name = \"b\"", "name = \"a\""),
+            "scene.toml:7: object 2, field name: \"a\" is also object 1",
+        ),
+        (
+            GOOD.replace("asset = \"cube.obj\"", "asset = \"missing.obbt\""),
+            "scene.toml:8: object 2, field asset: ",
+        ),
+        (
+            GOOD.replace("asset = \"cube.obj\"", "asset = \"corrupt.obbt\""),
+            "scene.toml:8: object 2, field asset: ",
+        ),
+        (
+            GOOD.replace("asset = \"cube.obj\"", "asset = \"cube-aabb.obbt\""),
+            "stores aabb f32 but \"a\" stores obb f32",
+        ),
+        (
+            GOOD.replace("effect = \"none\"", "effect = \"explode\""),
+            "scene.toml:14: rule 1, field effect: unknown effect \"explode\"",
+        ),
+        (
+            GOOD.replace("clearance = 0.5\n", ""),
+            "scene.toml:19: rule 2, field clearance: effect \"clearance\" needs",
+        ),
+        (
+            GOOD.replace("clearance = 0.5", "clearance = -1"),
+            "scene.toml:20: rule 2, field clearance: must be a finite number > 0",
+        ),
+        (
+            GOOD.replace("effect = \"none\"", "effect = \"none\"\nmax_distance = 2"),
+            "scene.toml:15: rule 1, field max_distance: max_distance does not apply",
+        ),
+        (
+            GOOD.replace("pose = [1,0,0,", "pose = [2,0,0,"),
+            "scene.toml:9: object 2, field pose: rotation is not orthonormal",
+        ),
+        (
+            GOOD.replace("name = \"b\"", "name = \"b c\""),
+            "object 2, field name: \"b c\" is not a name",
+        ),
+        (
+            GOOD.replace("groups = [\"g\"]", "grups = [\"g\"]"),
+            "scene.toml:4: unknown field `grups`",
+        ),
+        (format!("{GOOD}\n[[rule]\n"), "scene.toml:22"),
+    ];
+    for (text, needle) in cases {
+        let o = run(&dir, &text, None);
+        assert_bad_input(&o, needle);
+        assert!(o.stdout.is_empty());
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_frames_stop_at_their_line_after_printing_the_frames_before() {
+    let dir = scene_dir("badframes");
+    let good = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 2,0,0]}}";
+    let cases = [
+        (
+            "{\"poses\": {\"zed\": [1,0,0, 0,1,0, 0,0,1, 0,0,0]}}",
+            "frames.jsonl:3: poses.zed: no object named \"zed\"",
+        ),
+        (
+            "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 0,0]}}",
+            "frames.jsonl:3: poses.b: a pose in format rt has 12 numbers",
+        ),
+        (
+            "{\"poses\": {\"b\": [-1,0,0, 0,1,0, 0,0,1, 0,0,0]}}",
+            "frames.jsonl:3: poses.b: rotation has determinant",
+        ),
+        (
+            "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1.1, 0,0,0]}}",
+            "frames.jsonl:3: poses.b: rotation is not orthonormal",
+        ),
+        (
+            "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 0,0,",
+            "frames.jsonl:3: not a frame",
+        ),
+        (
+            "{\"pose\": {}}",
+            "frames.jsonl:3: not a frame: unknown field `pose`",
+        ),
+        ("", "frames.jsonl:3: empty line"),
+    ];
+    for (bad, needle) in cases {
+        let o = run(
+            &dir,
+            GOOD,
+            Some(&format!("{good}\n{good}\n{bad}\n{good}\n")),
+        );
+        assert_bad_input(&o, needle);
+        // The two frames before the bad line were printed.
+        assert_eq!(json_lines(&o.stdout).len(), 2, "{needle}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
