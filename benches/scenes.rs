@@ -1,8 +1,8 @@
 //! Scene benchmarks (`cargo bench --bench scenes`), printed as tables:
 //!
 //! - (a) 200 objects from the shipped cell's trees (arm links, gripper, fixtures, the
-//!   cow), 20 groups of 10, each pair of groups given `none` 70%, `contact` 20%,
-//!   `clearance` 8%, `distance` 2% (half of them limited to 2 units, half with
+//!   cow), 20 groups of 10, the 210 pairs of groups given `none` (147), `contact` (42),
+//!   `clearance` 0.05 (17), `distance` (4: two limited to 2 units, two unlimited with
 //!   `rel_err` 0.01); 50 objects move coherently, 150 are static; 1,000 frames. Frames
 //!   per second of the fast path, and of `--naive` on the first frames (its answers
 //!   checked identical there), in one run.
@@ -82,26 +82,32 @@ fn many_objects() -> (Scene, Scene, Vec<Vector3<f64>>) {
         );
         origins.push(origin);
     }
+    // Effects of the 210 group pairs, in the stated proportions, placed at random; the
+    // distance rules alternate between a range sensor (limited to 2, exact) and an
+    // unlimited distance within 1%.
+    let mut effects: Vec<Effect> = (0..210)
+        .map(|k| match k {
+            0..147 => Effect::None,
+            147..189 => Effect::Contact,
+            189..206 => Effect::Clearance { clearance: 0.05 },
+            k if k % 2 == 0 => Effect::Distance {
+                rel_err: 0.0,
+                max_distance: Some(2.0),
+            },
+            _ => Effect::Distance {
+                rel_err: 0.01,
+                max_distance: None,
+            },
+        })
+        .collect();
+    for k in (1..effects.len()).rev() {
+        let swap = (random.next() * (k + 1) as f64) as usize;
+        effects.swap(k, swap);
+    }
+    let mut effects = effects.into_iter();
     for i in 0..20 {
         for j in i..20 {
-            let p = random.next();
-            let effect = if p < 0.70 {
-                Effect::None
-            } else if p < 0.90 {
-                Effect::Contact
-            } else if p < 0.98 {
-                Effect::Clearance { clearance: 0.05 }
-            } else if random.next() < 0.5 {
-                Effect::Distance {
-                    rel_err: 0.0,
-                    max_distance: Some(2.0),
-                }
-            } else {
-                Effect::Distance {
-                    rel_err: 0.01,
-                    max_distance: None,
-                }
-            };
+            let effect = effects.next().unwrap_or(Effect::None);
             builder.rule(&format!("g{i}"), &format!("g{j}"), effect);
         }
     }
@@ -150,17 +156,26 @@ fn scene_benchmark() {
         s.frames,
         fast_fps,
         median(fast_times) * 1e3,
-        s.narrow.total(),
-        s.narrow.total() / s.frames,
+        s.narrow.total().queries,
+        s.narrow.total().queries / s.frames,
         s.culled,
         s.reused,
         s.warm_starts
     );
+    for (name, w) in s.narrow.by_effect() {
+        println!(
+            "         {name:<9} {:>6} queries, {:>9} box tests, {:>8} triangle tests, {:>8.1} ms",
+            w.queries,
+            w.box_tests,
+            w.triangle_tests,
+            w.seconds * 1e3
+        );
+    }
     println!(
         "  naive  {:>6} frames: {:>10.1} frames/s; narrow {} per frame",
         n.frames,
         naive_fps,
-        n.narrow.total() / n.frames.max(1)
+        n.narrow.total().queries / n.frames.max(1)
     );
     println!(
         "  fast / naive: {:.0}x faster, answers identical on the {checked} frames both ran",

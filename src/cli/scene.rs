@@ -170,9 +170,8 @@ fn finish(scene: &Scene, args: &SceneArgs) -> Result<(), Failure> {
     print_summary(s, mode)
 }
 
-/// The summary as a table.
+/// The summary as a table: what was skipped, then the narrow work by effect.
 pub fn print_summary(s: &Summary, mode: &str) -> Result<(), Failure> {
-    let n = &s.narrow;
     let pair_frames = s.pairs_with_effect * s.frames;
     out!("summary ({mode})")?;
     out!("  frames               {}", s.frames)?;
@@ -183,22 +182,30 @@ pub fn print_summary(s: &Summary, mode: &str) -> Result<(), Failure> {
     )?;
     out!("  culled (broad phase) {}", s.culled)?;
     out!("  reused answers       {}", s.reused)?;
-    out!(
-        "  narrow queries       {} (contact {}, contacts {}, clearance {}, distance {}, span {})",
-        n.total(),
-        n.contact,
-        n.contacts,
-        n.clearance,
-        n.distance,
-        n.span
-    )?;
     out!("  early exits          {}", s.early_exits)?;
     out!("  warm starts          {}", s.warm_starts)?;
-    out!("  triangle tests       {}", s.triangle_tests)?;
-    out!("  box tests            {}", s.box_tests)?;
     out!(
         "  time                 {} ({:.0} frames per second)",
         human_seconds(s.seconds),
         s.frames_per_second()
-    )
+    )?;
+    out!(
+        "  {:<10} {:>10} {:>12} {:>14} {:>12}",
+        "narrow",
+        "queries",
+        "box tests",
+        "triangle tests",
+        "time"
+    )?;
+    let total = s.narrow.total();
+    for (name, w) in s.narrow.by_effect().into_iter().chain([("total", &total)]) {
+        out!(
+            "  {name:<10} {:>10} {:>12} {:>14} {:>12}",
+            w.queries,
+            w.box_tests,
+            w.triangle_tests,
+            human_seconds(w.seconds)
+        )?;
+    }
+    Ok(())
 }

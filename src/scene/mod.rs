@@ -45,7 +45,7 @@ pub use error::SceneError;
 pub use file::{load, LoadedScene};
 pub use frames::FrameReader;
 pub use report::{
-    Answer, Event, EventKind, FrameReport, NarrowCounts, ObjectId, PairReport, Summary,
+    Answer, EffectWork, Event, EventKind, FrameReport, NarrowWork, ObjectId, PairReport, Summary,
 };
 pub use rules::Effect;
 pub use simulate::{Frame, Rule, Scene, SceneBuilder, SceneObject};

@@ -255,25 +255,84 @@ impl FrameReport {
     }
 }
 
-/// Narrow-phase queries run, by the effect they answered.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct NarrowCounts {
-    /// First-contact queries (`contact`).
-    pub contact: u64,
-    /// All-pairs collision queries (`contacts`).
-    pub contacts: u64,
-    /// Tolerance queries (`clearance`).
-    pub clearance: u64,
-    /// Distance queries (`distance`).
-    pub distance: u64,
-    /// Span queries (`span`).
-    pub span: u64,
+/// The narrow-phase work spent on one effect.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EffectWork {
+    /// Queries run.
+    pub queries: u64,
+    /// Bounding-volume pair tests.
+    pub box_tests: u64,
+    /// Triangle pair tests.
+    pub triangle_tests: u64,
+    /// Time in those queries (seconds, summed over threads).
+    pub seconds: f64,
 }
 
-impl NarrowCounts {
-    /// All queries.
-    pub fn total(&self) -> u64 {
-        self.contact + self.contacts + self.clearance + self.distance + self.span
+impl EffectWork {
+    pub(crate) fn add(&mut self, other: &EffectWork) {
+        self.queries += other.queries;
+        self.box_tests += other.box_tests;
+        self.triangle_tests += other.triangle_tests;
+        self.seconds += other.seconds;
+    }
+
+    fn to_json(self) -> Value {
+        json!({
+            "queries": self.queries,
+            "box_tests": self.box_tests,
+            "triangle_tests": self.triangle_tests,
+            "seconds": self.seconds,
+        })
+    }
+}
+
+/// Narrow-phase work by the effect it answered.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NarrowWork {
+    /// First-contact queries (`contact`).
+    pub contact: EffectWork,
+    /// All-pairs collision queries (`contacts`).
+    pub contacts: EffectWork,
+    /// Tolerance queries (`clearance`).
+    pub clearance: EffectWork,
+    /// Distance queries (`distance`).
+    pub distance: EffectWork,
+    /// Span queries (`span`).
+    pub span: EffectWork,
+}
+
+impl NarrowWork {
+    /// Each effect's work with the effect's name, in the order of the scene file's list.
+    pub fn by_effect(&self) -> [(&'static str, &EffectWork); 5] {
+        [
+            ("contact", &self.contact),
+            ("contacts", &self.contacts),
+            ("clearance", &self.clearance),
+            ("distance", &self.distance),
+            ("span", &self.span),
+        ]
+    }
+
+    /// The work of `effect` (`None` for `none`, which never runs a query).
+    pub(crate) fn of(&mut self, effect: &super::Effect) -> Option<&mut EffectWork> {
+        use super::Effect;
+        match effect {
+            Effect::None => None,
+            Effect::Contact => Some(&mut self.contact),
+            Effect::Contacts => Some(&mut self.contacts),
+            Effect::Clearance { .. } => Some(&mut self.clearance),
+            Effect::Distance { .. } => Some(&mut self.distance),
+            Effect::Span => Some(&mut self.span),
+        }
+    }
+
+    /// All effects together.
+    pub fn total(&self) -> EffectWork {
+        let mut total = EffectWork::default();
+        for (_, work) in self.by_effect() {
+            total.add(work);
+        }
+        total
     }
 }
 
@@ -291,17 +350,13 @@ pub struct Summary {
     pub culled: u64,
     /// Pair-frames answered by reusing the previous answer (neither object moved).
     pub reused: u64,
-    /// Narrow-phase queries run.
-    pub narrow: NarrowCounts,
+    /// Narrow-phase queries and their work, by effect.
+    pub narrow: NarrowWork,
     /// Narrow queries that stopped early: a first contact found, a clearance violated,
     /// or a limited distance found far.
     pub early_exits: u64,
     /// Distance queries started from the previous frame's witness pair.
     pub warm_starts: u64,
-    /// Triangle pair tests of all narrow queries.
-    pub triangle_tests: u64,
-    /// Bounding-volume pair tests of all narrow queries.
-    pub box_tests: u64,
     /// Wall time spent in frames (seconds).
     pub seconds: f64,
 }
@@ -318,7 +373,12 @@ impl Summary {
 
     /// `{"summary": {...}}`; `mode` is `fast` or `naive`.
     pub fn to_json(&self, mode: &str) -> Value {
-        let n = &self.narrow;
+        let mut narrow = serde_json::Map::new();
+        for (name, work) in self.narrow.by_effect() {
+            narrow.insert(name.to_owned(), work.to_json());
+        }
+        let total = self.narrow.total();
+        narrow.insert("total".to_owned(), total.to_json());
         json!({"summary": {
             "mode": mode,
             "frames": self.frames,
@@ -326,18 +386,11 @@ impl Summary {
             "pairs_with_effect": self.pairs_with_effect,
             "culled": self.culled,
             "reused": self.reused,
-            "narrow": {
-                "contact": n.contact,
-                "contacts": n.contacts,
-                "clearance": n.clearance,
-                "distance": n.distance,
-                "span": n.span,
-                "total": n.total(),
-            },
+            "narrow": narrow,
             "early_exits": self.early_exits,
             "warm_starts": self.warm_starts,
-            "triangle_tests": self.triangle_tests,
-            "box_tests": self.box_tests,
+            "triangle_tests": total.triangle_tests,
+            "box_tests": total.box_tests,
             "seconds": self.seconds,
             "frames_per_second": self.frames_per_second(),
         }})

@@ -4,7 +4,7 @@
 use super::broad::{Bounds, SweepAndPrune};
 use super::error::SceneError;
 use super::report::{
-    Answer, Event, EventKind, FrameReport, NarrowCounts, ObjectId, PairReport, Summary,
+    Answer, EffectWork, Event, EventKind, FrameReport, ObjectId, PairReport, Summary,
 };
 use super::rules::{Effect, Reach, RuleTable};
 use crate::bv::BoundingVolume;
@@ -241,6 +241,8 @@ struct Outcome {
     witness: Option<Witness>,
     stats: Stats,
     early_exit: bool,
+    /// Time the query took.
+    seconds: f64,
 }
 
 /// Many objects moving over frames, each pair of objects with the effect its rules give
@@ -454,7 +456,12 @@ impl Scene {
             .par_iter()
             .with_min_len(4)
             .map_init(QueryContext::new, |context, job| {
-                run_job(job, objects, naive, context)
+                let started = Instant::now();
+                let mut outcome = run_job(job, objects, naive, context);
+                if let Ok(o) = &mut outcome {
+                    o.seconds = started.elapsed().as_secs_f64();
+                }
+                outcome
             })
             .collect();
         for (job, outcome) in jobs.iter().zip(outcomes) {
@@ -572,19 +579,16 @@ impl Scene {
 
     fn count(&mut self, job: &Job, outcome: &Outcome) {
         let s = &mut self.summary;
-        let n: &mut NarrowCounts = &mut s.narrow;
-        match job.effect {
-            Effect::None => {}
-            Effect::Contact => n.contact += 1,
-            Effect::Contacts => n.contacts += 1,
-            Effect::Clearance { .. } => n.clearance += 1,
-            Effect::Distance { .. } => n.distance += 1,
-            Effect::Span => n.span += 1,
+        if let Some(work) = s.narrow.of(&job.effect) {
+            work.add(&EffectWork {
+                queries: 1,
+                box_tests: outcome.stats.bv_disjoint + outcome.stats.bv_overlap,
+                triangle_tests: outcome.stats.tri_separated + outcome.stats.tri_contact,
+                seconds: outcome.seconds,
+            });
         }
         s.early_exits += u64::from(outcome.early_exit);
         s.warm_starts += u64::from(job.warm.is_some() && !self.naive);
-        s.triangle_tests += outcome.stats.tri_separated + outcome.stats.tri_contact;
-        s.box_tests += outcome.stats.bv_disjoint + outcome.stats.bv_overlap;
     }
 }
 
@@ -655,6 +659,7 @@ fn run_job(
             witness,
             stats,
             early_exit,
+            seconds: 0.0,
         };
         let exact = DistanceOptions::default();
         Ok(match (job.effect, naive) {
