@@ -64,7 +64,7 @@ pub fn main() -> ExitCode {
         Command::Collide(args) => query::collide(&args),
         Command::Distance(args) => query::distance(&args),
         Command::Span(args) => query::span(&args),
-        Command::Scene(args) => scene::run(&args),
+        Command::Scene(args) => scene::run(&args).map(|_| ()),
         Command::Demo(args) => demo::run(&args),
     };
     match outcome {

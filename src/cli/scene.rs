@@ -59,7 +59,8 @@ pub struct SceneArgs {
     pub summary_only: bool,
 }
 
-pub fn run(args: &SceneArgs) -> Result<(), Failure> {
+/// Runs the scene of `args`, prints what it asks for, and returns the summary.
+pub fn run(args: &SceneArgs) -> Result<Summary, Failure> {
     let LoadedScene {
         mut scene,
         frames,
@@ -161,13 +162,15 @@ fn show(scene: &mut Scene, args: &SceneArgs, frame: &obbtree::scene::Frame) -> R
     Ok(())
 }
 
-fn finish(scene: &Scene, args: &SceneArgs) -> Result<(), Failure> {
-    let s = scene.summary();
+fn finish(scene: &Scene, args: &SceneArgs) -> Result<Summary, Failure> {
+    let s = *scene.summary();
     let mode = if args.naive { "naive" } else { "fast" };
     if args.json {
-        return out!("{}", s.to_json(mode));
+        out!("{}", s.to_json(mode))?;
+    } else {
+        print_summary(&s, mode)?;
     }
-    print_summary(s, mode)
+    Ok(s)
 }
 
 /// The summary as a table: what was skipped, then the narrow work by effect.
