@@ -6,6 +6,9 @@
 //! `cargo run --release --example make_cell` regenerates every file byte for byte (a test
 //! checks that rebuilding each shipped tree gives the committed bytes).
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use obbtree::build::{build, BuildOptions};
 use obbtree::mesh::TriMesh;
 use obbtree::nalgebra::{Matrix3, Rotation3, Vector3};
@@ -17,28 +20,10 @@ fn boxes(parts: &[([f64; 3], [f64; 3])]) -> TriMesh {
     let mut vertices = Vec::new();
     let mut faces = Vec::new();
     for (center, half) in parts {
+        let part = common::cuboid(*half, *center);
         let base = vertices.len() as u32;
-        for i in 0..8 {
-            vertices.push(std::array::from_fn(|k| {
-                center[k] + if i & (1 << k) == 0 { -half[k] } else { half[k] }
-            }));
-        }
-        for f in [
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ] {
-            faces.push(f.map(|v: u32| base + v));
-        }
+        vertices.extend_from_slice(part.vertices());
+        faces.extend(part.faces().iter().map(|f| f.map(|v| base + v)));
     }
     TriMesh::new(vertices, faces).expect("valid boxes")
 }

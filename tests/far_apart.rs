@@ -15,7 +15,7 @@ use obbtree::format::ObbtFile;
 use obbtree::query::triangle::{triangle_distance, Triangle};
 use obbtree::query::{
     collide_files, distance_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, Pose, QueryContext, Stats,
+    DistanceOptions, DistanceResult, Pose, QueryContext, Stats,
 };
 use obbtree::real::Precision;
 
@@ -122,6 +122,15 @@ fn distance_work_does_not_grow_with_the_offset() {
     }
 }
 
+/// The exact distance between the model at the identity and a copy moved `offset` along
+/// x, and that copy's pose.
+fn along_x(file: &ObbtFile, offset: f64, context: &mut QueryContext) -> (Pose, DistanceResult) {
+    let pose = Pose::translation(offset, 0.0, 0.0);
+    let exact = DistanceOptions::default();
+    let r = distance_files(file, &Pose::identity(), file, &pose, &exact, context).unwrap();
+    (pose, r)
+}
+
 /// Far apart, the exact distance is still exact. Along x, only triangles of A reaching
 /// within 0.05 of its largest x and of B within 0.05 of its smallest can hold the closest
 /// pair (every other pair is farther apart in x alone than the answer), so a brute force
@@ -154,16 +163,7 @@ fn far_distances_stay_exact() {
             .filter(|(_, t)| t.iter().any(|p| p[0] < min_x + 0.05))
             .collect();
         for offset in OFFSETS {
-            let pose = Pose::translation(offset, 0.0, 0.0);
-            let r = distance_files(
-                &file,
-                &Pose::identity(),
-                &file,
-                &pose,
-                &DistanceOptions::default(),
-                &mut context,
-            )
-            .unwrap();
+            let (pose, r) = along_x(&file, offset, &mut context);
             // B mapped into A's frame as the query maps it.
             let xf = Pose::relative(&Pose::identity(), &pose);
             let brute = right
@@ -199,16 +199,7 @@ fn models_beyond_f64_resolution_do_not_open_every_pair() {
     let file = build(&cow, &BuildOptions::default(), None).unwrap();
     let mut context = QueryContext::new();
     for offset in [1e13, 1e16, 1e100, 1e300] {
-        let pose = Pose::translation(offset, 0.0, 0.0);
-        let r = distance_files(
-            &file,
-            &Pose::identity(),
-            &file,
-            &pose,
-            &DistanceOptions::default(),
-            &mut context,
-        )
-        .unwrap();
+        let (_, r) = along_x(&file, offset, &mut context);
         assert!(
             triangle_tests(&r.stats) <= 1000,
             "{offset:e}: {:?}",

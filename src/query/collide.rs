@@ -29,8 +29,9 @@ impl Default for CollideOptions {
     }
 }
 
-/// The answer of a collision query.
-#[derive(Clone, Debug, PartialEq)]
+/// The answer of a collision query (the default is "not colliding", an empty buffer to
+/// pass to `collide_into`).
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CollideResult {
     /// Whether any triangle of A touches any triangle of B.
     pub colliding: bool,
@@ -95,11 +96,7 @@ pub fn collide<B: BoundingVolume>(
     options: &CollideOptions,
     context: &mut QueryContext,
 ) -> Result<CollideResult, QueryError> {
-    let mut result = CollideResult {
-        colliding: false,
-        pairs: Vec::new(),
-        stats: Stats::default(),
-    };
+    let mut result = CollideResult::default();
     collide_into(a, pose_a, b, pose_b, options, context, &mut result)?;
     Ok(result)
 }

@@ -66,11 +66,7 @@ impl<'f> PairQuery<'f> {
         pose_b: &Pose,
         options: &CollideOptions,
     ) -> Result<CollideResult, QueryError> {
-        let mut result = CollideResult {
-            colliding: false,
-            pairs: Vec::new(),
-            stats: Stats::default(),
-        };
+        let mut result = CollideResult::default();
         self.collide_into(pose_a, pose_b, options, &mut result)?;
         Ok(result)
     }

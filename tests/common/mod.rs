@@ -1,6 +1,8 @@
 //! Meshes generated in code, shared by the integration tests.
 #![allow(dead_code)]
 
+// Integration tests only: the binary's path is known to them at compile time.
+#[cfg(test)]
 pub mod cli;
 pub mod mutate;
 pub mod seal;
