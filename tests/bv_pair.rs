@@ -297,6 +297,9 @@ fn thin_boxes_far_apart_are_bounded_along_the_centre_line() {
         // line: (circumradius sum)^2 / far; no lower bound may exceed it.
         let bulge = (2.0 * half.norm()).powi(2) / far;
         assert!(lb <= gap + bulge, "{far}: {lb} above the distance");
-        assert!(lb >= gap - 1e-5, "{far}: {lb} short of the centre-line gap {gap}");
+        assert!(
+            lb >= gap - 1e-5,
+            "{far}: {lb} short of the centre-line gap {gap}"
+        );
     }
 }

@@ -52,6 +52,7 @@ pub fn to_json(info: &Info) -> serde_json::Value {
         "leaf_size": info.leaf_size,
         "encoding": info.encoding.name(),
         "bounds": {"min": info.bounds_min, "max": info.bounds_max},
+        "placement": {"scale": info.placement.scale, "offset": info.placement.offset},
         "file_bytes": info.file_bytes,
         "bytes_per_triangle": info.file_bytes as f64 / f64::from(info.triangles.max(1)),
         "sections": sections,
@@ -84,6 +85,14 @@ fn print_text(name: &str, info: &Info) {
         "  bounds         {:?} .. {:?}",
         info.bounds_min, info.bounds_max
     );
+    if info.placement.is_identity() {
+        println!("  placement      none (stored = input coordinates)");
+    } else {
+        println!(
+            "  placement      {} (stored = scale · input + offset)",
+            info.placement
+        );
+    }
     println!(
         "  size           {} ({:.1} bytes per triangle)",
         human_bytes(info.file_bytes),
