@@ -8,7 +8,8 @@ use std::path::PathBuf;
 
 /// Show what a .obbt file holds: counts, tree shape, build options, sections.
 ///
-/// Reads only the header and section directory, so it takes the same time for any file
+/// Reads only the header, the section directory and the 32-byte placement record (the scale
+/// and offset `build --scale / --center` applied), so it takes the same time for any file
 /// size. It does not check the sections: use `obbtree verify` for that.
 #[derive(Args, Debug)]
 pub struct InfoArgs {

@@ -47,7 +47,8 @@ pub struct Header {
     pub signature: [u8; 8],
     /// [`VERSION_MAJOR`].
     pub version_major: U16,
-    /// [`VERSION_MINOR`].
+    /// The lowest minor version that defines every section of the file (0 or 1 from this
+    /// writer, see [`VERSION_MINOR`]); readers accept any.
     pub version_minor: U16,
     /// Bytes of header plus directory: `128 + 40 * section_count`.
     pub header_bytes: U32,
