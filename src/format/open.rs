@@ -163,7 +163,8 @@ fn field(field: &'static str, offset: usize, problem: impl Into<String>) -> Form
 }
 
 impl ObbtFile {
-    /// Memory-maps `path` and checks its header and directory (O(1) in the file size).
+    /// Memory-maps `path`, checks its header and directory and decodes its placement record
+    /// (O(1) in the file size).
     ///
     /// This is the one place obbtree maps files. The map is read-only and private to this
     /// value; every later read goes through checked slices of it.
