@@ -233,7 +233,8 @@ impl ObbtFile {
         self.placement
     }
 
-    /// What the header says about the tree (reads no section).
+    /// What the header says about the tree, with the placement decoded on open (reads no
+    /// section).
     pub fn info(&self) -> Info {
         let h = &self.header;
         Info {
@@ -570,7 +571,6 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
     for (range, kind) in ranges.iter_mut().zip(SectionKind::REQUIRED) {
         *range = range_of(kind).ok_or(FormatError::MissingSection(kind.name()))?;
     }
-
     // `triangles` is at least 1 (checked above), and doubling a `u32` fits a `u64`.
     let binary_nodes = u64::from(header.triangles.get())
         .saturating_mul(2)
