@@ -81,7 +81,7 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         return;
     }
     // The default options, and one more combination picked from the input's bytes so the
-    // other volumes, precisions, fits and the variable encoding get built too.
+    // other volumes, precisions, fits, the variable encoding and placements get built too.
     let pick = data.iter().fold(0usize, |h, &b| {
         h.wrapping_mul(31).wrapping_add(usize::from(b))
     });
@@ -90,6 +90,8 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         precision: [Precision::F32, Precision::F64][(pick / 3) % 2],
         fit: [FitMethod::Hull, FitMethod::Triangles, FitMethod::Vertices][(pick / 6) % 3],
         leaf_size: [1, 2, 4, 128][(pick / 18) % 4],
+        scale: [1.0, 1e-3, 1e3][(pick / 72) % 3],
+        center: (pick / 216) % 2 == 1,
     };
     for options in [BuildOptions::default(), other] {
         match build(mesh, &options, None) {
@@ -111,6 +113,8 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
             }
             // Coordinates beyond the f32 range are refused for f32 files, by design.
             Err(BuildError::CoordinateOverflow { .. }) if options.precision == Precision::F32 => {}
+            // So are coordinates that scaling or centring takes beyond the f64 range.
+            Err(BuildError::PlacementOverflow { .. }) if options.scale > 1.0 || options.center => {}
             Err(error) => panic!(
                 "a loaded mesh of {} triangles does not build ({options:?}): {error}",
                 mesh.faces().len()

@@ -87,6 +87,7 @@ pub mod bv;
 pub mod fit;
 pub mod format;
 pub mod mesh;
+pub mod placement;
 pub mod query;
 pub mod real;
 pub mod scene;

@@ -3,7 +3,7 @@
 mod common;
 
 use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn build(out: &Path, extra: &[&str]) {
@@ -751,5 +751,166 @@ fn flags_that_cannot_apply_and_readable_numbers() {
     let o = obbtree(&["demo"]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(!text.contains(" 0 us") && !text.contains(" 0 µs"), "{text}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Writes the bundled cow as an OBJ in `dir`, every vertex `p` written as `factor · p + shift`
+/// (shortest round-trip decimals), same faces.
+fn cow_in_other_units(dir: &Path, factor: f64, shift: [f64; 3]) -> PathBuf {
+    use std::fmt::Write;
+    let mesh = obbtree::mesh::TriMesh::load(Path::new(&cow())).unwrap();
+    let mut text = String::new();
+    for v in mesh.vertices() {
+        let [x, y, z]: [f64; 3] = std::array::from_fn(|k| factor * v[k] + shift[k]);
+        writeln!(text, "v {x:?} {y:?} {z:?}").unwrap();
+    }
+    for f in mesh.faces() {
+        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
+    }
+    let path = dir.join("cow-mm.obj");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `obbtree ARGS` must succeed and print one JSON object.
+fn json_of(args: &[&str]) -> serde_json::Value {
+    let o = obbtree(args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("one JSON object")
+}
+
+#[test]
+fn scale_and_center_are_recorded_shown_and_queried_together() {
+    let dir = scratch("units");
+    // The cow drawn in millimetres, 982 m out along -x (and 500 m, 3 m along y, z).
+    let mm = cow_in_other_units(&dir, 1000.0, [-982_000.0, 500_000.0, 3000.0]);
+    let placed = dir.join("placed.obbt");
+    let plain = dir.join("plain.obbt");
+    let (p, q) = (placed.to_str().unwrap(), plain.to_str().unwrap());
+    let o = obbtree(&[
+        "build",
+        mm.to_str().unwrap(),
+        "-o",
+        p,
+        "--scale",
+        "0.001",
+        "--center",
+        "--precision",
+        "f64",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    build(&plain, &["--precision", "f64"]);
+    assert!(obbtree(&["verify", p]).status.success());
+
+    let info = json_of(&["info", "--json", p]);
+    assert_eq!(info["version"], "1.1");
+    assert_eq!(info["placement"]["scale"], 0.001);
+    let offset: Vec<f64> = info["placement"]["offset"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_f64().unwrap())
+        .collect();
+    for (got, want) in offset.iter().zip([982.0, -500.0, -3.0]) {
+        assert!((got - want).abs() < 1e-9, "offset {offset:?}");
+    }
+    // Stored in metres around the origin: the plain cow's bounds.
+    let plain_info = json_of(&["info", "--json", q]);
+    for end in ["min", "max"] {
+        for k in 0..3 {
+            let (got, want) = (
+                info["bounds"][end][k].as_f64().unwrap(),
+                plain_info["bounds"][end][k].as_f64().unwrap(),
+            );
+            assert!(
+                (got - want).abs() < 1e-9,
+                "bounds.{end}[{k}]: {got} vs {want}"
+            );
+        }
+    }
+    let sections = info["sections"].as_array().unwrap();
+    assert_eq!(sections.last().unwrap()["name"], "placement");
+    // Without the flags: version 1.0, the identity, no section.
+    assert_eq!(plain_info["version"], "1.0");
+    assert_eq!(
+        plain_info["placement"],
+        serde_json::json!({"scale": 1.0, "offset": [0.0, 0.0, 0.0]})
+    );
+    assert_eq!(plain_info["sections"].as_array().unwrap().len(), 4);
+
+    let text = |file: &str| String::from_utf8_lossy(&obbtree(&["info", file]).stdout).into_owned();
+    let placed_text = text(p);
+    assert!(
+        placed_text.contains("placement      scale 0.001, offset [")
+            && placed_text.contains("(stored = scale · input + offset)"),
+        "{placed_text}"
+    );
+    assert!(text(q).contains("placement      none"), "{}", text(q));
+
+    // The model made in millimetres far away answers as the one made in metres at home.
+    // (A generic rotation: with an exact one such as a quarter turn, some triangle pairs
+    // touch exactly, and the rounding of any placement, even a scale of 1 + 2e-16, flips
+    // them.)
+    let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -0.2, 0.5);
+    let pose = |t: [f64; 3]| {
+        let r = rotation.matrix();
+        let numbers: Vec<String> = (0..3)
+            .flat_map(|i| (0..3).map(move |j| r[(i, j)]))
+            .chain(t)
+            .map(|c| format!("{c:?}"))
+            .collect();
+        numbers.join(",")
+    };
+    let (turned, far) = (pose([0.2, 0.05, 0.01]), pose([1.5, 0.3, 0.0]));
+    let (turned, far) = (turned.as_str(), far.as_str());
+    let contacts =
+        |a: &str| json_of(&["collide", a, q, "--pose-b", turned, "--json"])["contacts"].clone();
+    assert!(contacts(q).as_u64().unwrap() > 0);
+    assert_eq!(contacts(p), contacts(q));
+    let distance = |a: &str| {
+        json_of(&["distance", a, q, "--pose-b", far, "--json"])["distance"]
+            .as_f64()
+            .unwrap()
+    };
+    let (got, want) = (distance(p), distance(q));
+    assert!(
+        want > 0.0 && (got - want).abs() <= 1e-9 * want,
+        "{got} vs {want}"
+    );
+
+    // A flipped byte of the placement record: info still reads the header, verify refuses.
+    let mut bytes = std::fs::read(&placed).unwrap();
+    let at = sections.last().unwrap()["offset"].as_u64().unwrap() as usize;
+    bytes[at + 3] ^= 0x04;
+    let damaged = dir.join("damaged.obbt");
+    std::fs::write(&damaged, &bytes).unwrap();
+    assert_bad_input(
+        &obbtree(&["verify", damaged.to_str().unwrap()]),
+        "placement",
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_scales_are_exit_1_naming_the_flag() {
+    let dir = scratch("badscale");
+    let out = dir.join("x.obbt");
+    let out = out.to_str().unwrap();
+    for scale in ["0", "nan", "-1", "-inf", "inf", "1e-400"] {
+        assert_bad_input(
+            &obbtree(&["build", &cow(), "-o", out, "--scale", scale, "--quiet"]),
+            "--scale",
+        );
+        assert!(!Path::new(out).exists(), "a refused build writes nothing");
+    }
+    // The options are checked before the mesh is read.
+    assert_bad_input(
+        &obbtree(&["build", "/nonexistent/mesh.obj", "-o", out, "--scale", "0"]),
+        "--scale",
+    );
+    // Not a number at all is a usage error, like any malformed value.
+    let o = obbtree(&["build", &cow(), "-o", out, "--scale", "ten"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -18,18 +18,40 @@ fn assert_rejected(bytes: &[u8], what: &str) {
     }
 }
 
+/// Every byte of `file`, XORed with 0x01 and with 0xff, is refused by open or verify.
+fn assert_every_flip_rejected(file: &ObbtFile, what: &str) {
+    let original = file.bytes().to_vec();
+    for i in 0..original.len() {
+        for mask in [0x01u8, 0xff] {
+            let mut bytes = original.clone();
+            bytes[i] ^= mask;
+            assert_rejected(&bytes, &format!("{what} byte {i} ^ {mask:#x}"));
+        }
+    }
+}
+
 #[test]
 fn every_single_byte_flip_of_a_small_file_is_detected() {
     for options in common::all_options() {
         let file = build(&common::cube(1.0), &options, None).unwrap();
-        let original = file.bytes().to_vec();
-        for i in 0..original.len() {
-            for mask in [0x01u8, 0xff] {
-                let mut bytes = original.clone();
-                bytes[i] ^= mask;
-                assert_rejected(&bytes, &format!("{options:?} byte {i} ^ {mask:#x}"));
-            }
-        }
+        assert_every_flip_rejected(&file, &format!("{options:?}"));
+    }
+}
+
+#[test]
+fn every_single_byte_flip_of_a_placed_file_is_detected() {
+    // With the optional placement section (format 1.1), its directory entry and its record
+    // are covered like every other byte.
+    let cuboid = common::cuboid([0.5; 3], [3.0, -2.0, 1.0]);
+    for options in common::all_options() {
+        let options = BuildOptions {
+            scale: 0.001,
+            center: true,
+            ..options
+        };
+        let file = build(&cuboid, &options, None).unwrap();
+        assert!(!file.placement().is_identity());
+        assert_every_flip_rejected(&file, &format!("{options:?}"));
     }
 }
 

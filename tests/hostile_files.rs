@@ -17,8 +17,8 @@
 mod common;
 
 use common::mutate::{
-    entry_offset, exercise, extreme_values, read_uint, write_uint, Outcome, Poses, Rng, Tally,
-    ENTRY_FIELDS, HEADER_FIELDS,
+    entry_field, entry_offset, exercise, extreme_values, read_uint, write_uint, Outcome, Poses,
+    Rng, Tally, ENTRY_FIELDS, HEADER_FIELDS,
 };
 use common::seal::seal;
 use obbtree::build::{build, BuildOptions};
@@ -365,18 +365,10 @@ fn overlapping_misaligned_and_oversized_sections_are_named() {
     let file = build(&common::cube(1.0), &BuildOptions::default(), None).expect("builds");
     let original = file.bytes().to_vec();
     let len = original.len() as u64;
-    let entry = |index: usize, field: &str| {
-        let (_, at, width) = ENTRY_FIELDS
-            .iter()
-            .find(|(name, _, _)| *name == field)
-            .copied()
-            .expect("a field");
-        (entry_offset(index) + at, width)
-    };
     let refused = |edits: &[(usize, &str, u64)], needle: &str| {
         let mut bytes = original.clone();
         for &(index, field, value) in edits {
-            let (at, width) = entry(index, field);
+            let (at, width) = entry_field(index, field);
             write_uint(&mut bytes, at, width, value);
         }
         seal(&mut bytes);
@@ -386,7 +378,7 @@ fn overlapping_misaligned_and_oversized_sections_are_named() {
         assert!(err.contains(needle), "{edits:?}: {needle:?} not in {err:?}");
     };
     let offset_of = |index: usize| {
-        let (at, width) = entry(index, "offset");
+        let (at, width) = entry_field(index, "offset");
         read_uint(&original, at, width)
     };
     // Faces moved onto the vertices: same length, aligned, in bounds, but overlapping.

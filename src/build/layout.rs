@@ -6,6 +6,7 @@ use super::BuiltTree;
 use crate::arr3;
 use crate::bv::BoundingVolume;
 use crate::mesh::triangle_is_degenerate;
+use crate::placement::Placement;
 use crate::tree::{Encoding, NodeRef};
 
 /// Whole-tree statistics, computed once at build time and stored in the file header so that
@@ -20,9 +21,9 @@ pub struct TreeStats {
     pub max_leaf_faces: u32,
     /// Triangles of zero area as stored (exactly zero cross product of the stored corners).
     pub degenerate_triangles: u32,
-    /// Componentwise minimum of all stored vertices, model units.
+    /// Componentwise minimum of all stored vertices, stored units (see [`Placement`]).
     pub bounds_min: [f64; 3],
-    /// Componentwise maximum of all stored vertices, model units.
+    /// Componentwise maximum of all stored vertices, stored units.
     pub bounds_max: [f64; 3],
 }
 
@@ -78,6 +79,7 @@ pub(crate) fn finish<B: BoundingVolume>(
     vertices: Vec<[B::Real; 3]>,
     degenerate_triangles: u32,
     (bounds_min, bounds_max): ([f64; 3], [f64; 3]),
+    placement: Placement,
 ) -> BuiltTree<B> {
     let shape = draft.shape;
     let node_count = draft.node_count();
@@ -104,6 +106,7 @@ pub(crate) fn finish<B: BoundingVolume>(
         nodes: draft.pieces,
         encoding,
         stats,
+        placement,
     }
 }
 

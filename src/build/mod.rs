@@ -16,13 +16,15 @@ use crate::bv::{Aabb, BoundingVolume, BvKind, Obb, Sphere};
 use crate::fit::FitMethod;
 use crate::format::{self, ObbtFile};
 use crate::mesh::TriMesh;
+use crate::placement::Placement;
 use crate::real::{Precision, Real};
 use crate::tree::{EncodeError, BINARY_MAX_FACE, VARIABLE_MAX_LEAF_FACES};
+use std::borrow::Cow;
 use std::sync::atomic::AtomicU64;
 
 /// Everything that decides the shape and contents of a built tree. The same mesh and options
 /// always give a byte-identical file, whatever the number of threads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuildOptions {
     /// The bounding volume stored in every node.
     pub bv: BvKind,
@@ -33,6 +35,13 @@ pub struct BuildOptions {
     /// Largest number of triangles in a leaf, 1 to 128. With 1 the tree is binary with
     /// single-face leaves and uses the compact binary encoding.
     pub leaf_size: u32,
+    /// Stored units per input unit: every input coordinate is multiplied by it before it is
+    /// stored (0.001 turns a mesh in millimetres into one in metres). Finite and greater than
+    /// 0; default 1. See [`Placement`].
+    pub scale: f64,
+    /// Move the centre of the (scaled) mesh's bounding box to the origin: the offset
+    /// `−scale · centre` is added to every vertex and recorded in the file. Default off.
+    pub center: bool,
 }
 
 impl Default for BuildOptions {
@@ -42,7 +51,23 @@ impl Default for BuildOptions {
             precision: Precision::F32,
             fit: FitMethod::Hull,
             leaf_size: 1,
+            scale: 1.0,
+            center: false,
         }
+    }
+}
+
+impl BuildOptions {
+    /// The checks of the options alone, before any mesh is read: `leaf_size` in 1..=128 and
+    /// a finite `scale` greater than 0. [`build`] runs them too.
+    pub fn validate(&self) -> Result<(), BuildError> {
+        if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&self.leaf_size) {
+            return Err(BuildError::LeafSize(self.leaf_size));
+        }
+        if !Placement::is_valid_scale(self.scale) {
+            return Err(BuildError::Scale(self.scale));
+        }
+        Ok(())
     }
 }
 
@@ -53,6 +78,9 @@ pub enum BuildError {
     /// `leaf_size` outside 1..=128.
     #[error("leaf size {0} is out of range (1 to {VARIABLE_MAX_LEAF_FACES})")]
     LeafSize(u32),
+    /// `scale` is not a finite number greater than 0.
+    #[error("scale {0} is not a finite number greater than 0 (--scale)")]
+    Scale(f64),
     /// The mesh is too large for the 32-bit references of the file format.
     #[error("the mesh is too large for the .obbt format: {0}")]
     TooLarge(#[from] EncodeError),
@@ -70,20 +98,36 @@ pub enum BuildError {
     /// can address (32-bit hosts), or (a bug) the header written fails the reader's checks.
     #[error("cannot lay out the .obbt image: {0}")]
     Image(String),
-    /// A coordinate is too large for the stored precision (beyond about 3.4e38 in f32).
+    /// A placed coordinate is too large for the stored precision (beyond about 3.4e38 in
+    /// f32).
     #[error("vertex {vertex} coordinate {value:e} does not fit the stored {precision} precision (it rounds to infinity); build with --precision f64")]
     CoordinateOverflow {
         /// Index of the vertex (0-based, input order).
         vertex: usize,
-        /// The input coordinate.
+        /// The coordinate to be stored: the input coordinate after the placement.
         value: f64,
         /// `f32` or `f64`.
         precision: &'static str,
+    },
+    /// Scaling or centring takes a coordinate beyond the f64 range.
+    #[error("vertex {vertex} coordinate {value:e} is beyond the f64 range after the placement ({placement}); use a smaller --scale")]
+    PlacementOverflow {
+        /// Index of the vertex (0-based, input order).
+        vertex: usize,
+        /// The input coordinate.
+        value: f64,
+        /// The placement that was applied.
+        placement: Placement,
     },
 }
 
 /// Builds the tree of `mesh` and lays it out as a complete `.obbt` image in memory (the same
 /// bytes [`ObbtFile::write_atomic`] puts on disk).
+///
+/// The vertices are first placed as `options` asks ([`Placement::for_points`]: `scale`, and
+/// with `center` the bounding-box centre moved to the origin), in f64; the tree, the stored
+/// vertices and the header's bounds are all in that stored frame, and a placement other than
+/// the identity is recorded in the file.
 ///
 /// `progress`, when given, is advanced by the number of triangles placed in leaves, up to
 /// `mesh.faces().len()`; another thread may poll it.
@@ -92,6 +136,7 @@ pub fn build(
     options: &BuildOptions,
     progress: Option<&AtomicU64>,
 ) -> Result<ObbtFile, BuildError> {
+    options.validate()?;
     match (options.bv, options.precision) {
         (BvKind::Obb, Precision::F32) => build_as::<Obb<f32>>(mesh, options, progress),
         (BvKind::Obb, Precision::F64) => build_as::<Obb<f64>>(mesh, options, progress),
@@ -107,9 +152,6 @@ fn build_as<B: BoundingVolume>(
     options: &BuildOptions,
     progress: Option<&AtomicU64>,
 ) -> Result<ObbtFile, BuildError> {
-    if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&options.leaf_size) {
-        return Err(BuildError::LeafSize(options.leaf_size));
-    }
     // Face indices must fit a binary leaf (a non-negative i32); vertex ids a u32.
     let limits = [
         (
@@ -124,30 +166,47 @@ fn build_as<B: BoundingVolume>(
             return Err(BuildError::TooManyElements { what, count, max });
         }
     }
+    let placement = Placement::for_points(options.scale, options.center, mesh.vertices());
+    // The identity is not applied at all: `1 · x + 0` would turn a −0 into +0, and files
+    // built without a placement stay byte-identical to those of format 1.0.
+    let placed: Cow<'_, [[f64; 3]]> = if placement.is_identity() {
+        Cow::Borrowed(mesh.vertices())
+    } else {
+        Cow::Owned(
+            mesh.vertices()
+                .iter()
+                .map(|&p| placement.apply(p))
+                .collect(),
+        )
+    };
     // Everything downstream sees the vertices exactly as stored, so the volumes contain the
     // stored (possibly f32-rounded) triangles, not the input ones.
-    let stored: Vec<[B::Real; 3]> = mesh
-        .vertices()
+    let stored: Vec<[B::Real; 3]> = placed
         .iter()
         .map(|p| p.map(<B::Real as Real>::from_f64_nearest))
         .collect();
     let positions: Vec<[f64; 3]> = stored.iter().map(crate::real::point_to_f64).collect();
-    // Input coordinates are finite (TriMesh checks), but f32 rounds beyond 3.4e38 to infinity,
-    // which would give a file that its own verify refuses.
-    let overflow =
-        positions
-            .iter()
-            .zip(mesh.vertices())
-            .enumerate()
-            .find_map(|(vertex, (p, input))| {
-                let k = p.iter().position(|c| !c.is_finite())?;
-                Some((vertex, input.get(k).copied().unwrap_or(f64::INFINITY)))
-            });
-    if let Some((vertex, value)) = overflow {
-        return Err(BuildError::CoordinateOverflow {
-            vertex,
-            value,
-            precision: <B::Real as Real>::PRECISION.name(),
+    // Input coordinates are finite (TriMesh checks), but a placement can take them beyond
+    // the f64 range, and f32 rounds beyond 3.4e38 to infinity: either would give a file that
+    // its own verify refuses.
+    let overflow = positions.iter().zip(placed.iter()).zip(mesh.vertices());
+    for (vertex, ((p, placed), input)) in overflow.enumerate() {
+        let Some(k) = p.iter().position(|c| !c.is_finite()) else {
+            continue;
+        };
+        let coordinate = |point: &[f64; 3]| point.get(k).copied().unwrap_or(f64::INFINITY);
+        return Err(if coordinate(placed).is_finite() {
+            BuildError::CoordinateOverflow {
+                vertex,
+                value: coordinate(placed),
+                precision: <B::Real as Real>::PRECISION.name(),
+            }
+        } else {
+            BuildError::PlacementOverflow {
+                vertex,
+                value: coordinate(input),
+                placement,
+            }
         });
     }
     // The statistics that do not depend on the tree are found alongside it.
@@ -160,7 +219,7 @@ fn build_as<B: BoundingVolume>(
             )
         },
     );
-    let tree = layout::finish(draft, stored, degenerate, bounds);
+    let tree = layout::finish(draft, stored, degenerate, bounds, placement);
     format::serialize(&tree, options)
 }
 
@@ -176,4 +235,7 @@ pub(crate) struct BuiltTree<B: BoundingVolume> {
     pub node_count: usize,
     pub encoding: crate::tree::Encoding,
     pub stats: TreeStats,
+    /// How the stored vertices were placed relative to the input; recorded in the file when
+    /// it is not the identity.
+    pub placement: Placement,
 }

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 /// Show what a .obbt file holds: counts, tree shape, build options, sections.
 ///
-/// Reads only the header and section directory, so it takes the same time for any file
+/// Reads only the header, the section directory and the 32-byte placement record (the scale
+/// and offset `build --scale / --center` applied), so it takes the same time for any file
 /// size. It does not check the sections: use `obbtree verify` for that.
 #[derive(Args, Debug)]
 pub struct InfoArgs {
@@ -54,6 +55,7 @@ pub fn to_json(info: &Info) -> serde_json::Value {
         "leaf_size": info.leaf_size,
         "encoding": info.encoding.name(),
         "bounds": {"min": info.bounds_min, "max": info.bounds_max},
+        "placement": {"scale": info.placement.scale, "offset": info.placement.offset},
         "file_bytes": info.file_bytes,
         "bytes_per_triangle": info.file_bytes as f64 / f64::from(info.triangles.max(1)),
         "sections": sections,
@@ -95,6 +97,14 @@ fn print_text(name: &str, info: &Info) -> Result<(), Failure> {
         stored_point(info, info.bounds_min),
         stored_point(info, info.bounds_max)
     )?;
+    if info.placement.is_identity() {
+        out!("  placement      none (stored = input coordinates)")?;
+    } else {
+        out!(
+            "  placement      {} (stored = scale · input + offset)",
+            info.placement
+        )?;
+    }
     out!(
         "  size           {} ({:.1} bytes per triangle)",
         human_bytes(info.file_bytes),

@@ -4,6 +4,7 @@
 //! byte-order types (alignment 1), so they can be read from any offset on any host; the
 //! sections are read zero-copy as native types, which is why big-endian hosts are refused.
 
+use crate::placement::Placement;
 use crate::real::Precision;
 use zerocopy::byteorder::little_endian::{F64, U16, U32, U64};
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -13,8 +14,12 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 pub const SIGNATURE: [u8; 8] = [0x89, b'O', b'B', b'T', b'\r', b'\n', 0x1a, b'\n'];
 /// Major version written and read: a reader refuses any other major version.
 pub const VERSION_MAJOR: u16 = 1;
-/// Minor version written: readers accept any minor version of their major version.
-pub const VERSION_MINOR: u16 = 0;
+/// Newest minor version this crate reads and writes: 1 (1.1 added the optional `placement`
+/// section). Readers accept any minor version of their major version. Writers write the
+/// lowest minor version that defines every section a file holds
+/// ([`SectionKind::minor_version`]), so a file without a placement is a 1.0 file, byte for
+/// byte what a 1.0 writer wrote.
+pub const VERSION_MINOR: u16 = 1;
 /// Every section starts at a multiple of this many bytes (a cache line), and the file length
 /// is a multiple of it too.
 pub const SECTION_ALIGN: u64 = 64;
@@ -42,7 +47,8 @@ pub struct Header {
     pub signature: [u8; 8],
     /// [`VERSION_MAJOR`].
     pub version_major: U16,
-    /// [`VERSION_MINOR`].
+    /// The lowest minor version that defines every section of the file (0 or 1 from this
+    /// writer, see [`VERSION_MINOR`]); readers accept any.
     pub version_minor: U16,
     /// Bytes of header plus directory: `128 + 40 * section_count`.
     pub header_bytes: U32,
@@ -116,7 +122,47 @@ const _: () = {
     assert!(std::mem::offset_of!(Header, header_crc) == HEADER_CRC_OFFSET);
 };
 
-/// The section kinds this version defines; all four are required.
+/// The placement record of the optional `placement` section (format 1.1): how the stored
+/// coordinates were made from the input mesh's, `stored = scale · input + offset`.
+///
+/// # Memory Layout
+///
+/// `#[repr(C)]`, alignment 1, 32 bytes: `scale: f64`, `offset: f64[3]`, little-endian
+/// (`formats/obbt.md` §5.6).
+#[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+#[repr(C)]
+pub struct PlacementRecord {
+    /// Stored units per input unit; finite and greater than 0 in a sound file.
+    pub scale: F64,
+    /// Added after scaling, stored units; finite in a sound file.
+    pub offset: [F64; 3],
+}
+
+/// Bytes of one [`PlacementRecord`]: the stride of the `placement` section.
+pub const PLACEMENT_STRIDE: u32 = 32;
+
+const _: () = assert!(std::mem::size_of::<PlacementRecord>() == PLACEMENT_STRIDE as usize);
+
+impl From<Placement> for PlacementRecord {
+    fn from(p: Placement) -> Self {
+        PlacementRecord {
+            scale: p.scale.into(),
+            offset: p.offset.map(Into::into),
+        }
+    }
+}
+
+impl From<PlacementRecord> for Placement {
+    fn from(r: PlacementRecord) -> Self {
+        Placement {
+            scale: r.scale.get(),
+            offset: r.offset.map(|v| v.get()),
+        }
+    }
+}
+
+/// The section kinds this version defines: four required ones and, since 1.1, the optional
+/// `placement`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SectionKind {
     /// Vertex positions: `[R; 3]` per vertex.
@@ -127,15 +173,28 @@ pub enum SectionKind {
     SourceIds,
     /// Tree nodes: volume + packed reference (see `bv::Node`).
     Nodes,
+    /// Optional (1.1): one [`PlacementRecord`], written when the placement is not the
+    /// identity.
+    Placement,
 }
 
 impl SectionKind {
-    /// The kinds in the order the writer lays them out.
-    pub const ALL: [SectionKind; 4] = [
+    /// The sections every file has, in the order the writer lays them out.
+    pub const REQUIRED: [SectionKind; 4] = [
         SectionKind::Vertices,
         SectionKind::Faces,
         SectionKind::SourceIds,
         SectionKind::Nodes,
+    ];
+
+    /// Every kind this reader knows: the required ones, then the optional ones, in the order
+    /// the writer lays them out.
+    pub const ALL: [SectionKind; 5] = [
+        SectionKind::Vertices,
+        SectionKind::Faces,
+        SectionKind::SourceIds,
+        SectionKind::Nodes,
+        SectionKind::Placement,
     ];
 
     /// The directory tag.
@@ -145,6 +204,24 @@ impl SectionKind {
             SectionKind::Faces => 2,
             SectionKind::SourceIds => 3,
             SectionKind::Nodes => 4,
+            SectionKind::Placement => 5,
+        }
+    }
+
+    /// Whether every file has this section; writers set the directory's REQUIRED flag
+    /// exactly on these.
+    pub fn is_required(self) -> bool {
+        SectionKind::REQUIRED.contains(&self)
+    }
+
+    /// The minor version (of major version 1) that defined this kind.
+    pub fn minor_version(self) -> u16 {
+        match self {
+            SectionKind::Vertices
+            | SectionKind::Faces
+            | SectionKind::SourceIds
+            | SectionKind::Nodes => 0,
+            SectionKind::Placement => 1,
         }
     }
 
@@ -160,6 +237,7 @@ impl SectionKind {
             SectionKind::Faces => "faces",
             SectionKind::SourceIds => "source_ids",
             SectionKind::Nodes => "nodes",
+            SectionKind::Placement => "placement",
         }
     }
 }

@@ -2,9 +2,10 @@
 //!
 //! `formats/obbt.md` is the specification; this module follows it. The split of checks is
 //! the one the spec prescribes: [`ObbtFile::open`] and [`ObbtFile::from_aligned`] check the
-//! header and section directory only (constant time, whatever the file size); the O(n)
-//! checks live in [`ObbtFile::verify`]. Queries on an unverified file use checked access, so
-//! a corrupt file gives an error or a wrong-but-safe answer, never undefined behaviour.
+//! header and section directory only, and decode the 32-byte placement record (constant
+//! time, whatever the file size); the O(n) checks live in [`ObbtFile::verify`]. Queries on
+//! an unverified file use checked access, so a corrupt file gives an error or a
+//! wrong-but-safe answer, never undefined behaviour.
 
 // Everything here reads untrusted bytes: on top of the crate's no-panic lints, integer
 // arithmetic must be checked or saturating and narrowing casts must be `try_from`.

@@ -3,11 +3,13 @@
 use super::aligned::AlignedBytes;
 use super::error::{FormatError, OpenError, VerifyError};
 use super::layout::{
-    align_up, header_crc, vertex_stride, Header, SectionEntry, SectionKind, ENTRY_SIZE,
-    FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, SECTION_ALIGN, SIGNATURE, VERSION_MAJOR,
+    align_up, header_crc, vertex_stride, Header, PlacementRecord, SectionEntry, SectionKind,
+    ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, PLACEMENT_STRIDE, SECTION_ALIGN,
+    SIGNATURE, VERSION_MAJOR,
 };
 use crate::bv::{Aabb, BoundingVolume, BvKind, Node, Obb, Sphere};
 use crate::fit::FitMethod;
+use crate::placement::Placement;
 use crate::real::{Precision, Real};
 use crate::tree::{Encoding, TreeView, VARIABLE_MAX_LEAF_FACES};
 use std::ops::Range;
@@ -36,12 +38,14 @@ pub struct ObbtFile {
     backing: Backing,
     header: Header,
     sections: Vec<SectionInfo>,
-    /// Byte ranges of the four required sections, in [`SectionKind::ALL`] order.
+    /// Byte ranges of the four required sections, in [`SectionKind::REQUIRED`] order.
     required: [Range<usize>; 4],
     bv: BvKind,
     precision: Precision,
     encoding: Encoding,
     fit: FitMethod,
+    /// Decoded from the `placement` section on open (identity without one).
+    placement: Placement,
 }
 
 impl std::fmt::Debug for ObbtFile {
@@ -112,10 +116,13 @@ pub struct Info {
     pub max_leaf_faces: u32,
     /// Zero-area triangles as stored.
     pub degenerate_triangles: u32,
-    /// Componentwise minimum of the vertices (model units).
+    /// Componentwise minimum of the stored vertices (stored units, see `placement`).
     pub bounds_min: [f64; 3],
-    /// Componentwise maximum of the vertices (model units).
+    /// Componentwise maximum of the stored vertices (stored units).
     pub bounds_max: [f64; 3],
+    /// How the stored coordinates were made from the input mesh's (identity when the file
+    /// has no `placement` section).
+    pub placement: Placement,
     /// File length in bytes.
     pub file_bytes: u64,
     /// The section directory.
@@ -156,7 +163,8 @@ fn field(field: &'static str, offset: usize, problem: impl Into<String>) -> Form
 }
 
 impl ObbtFile {
-    /// Memory-maps `path` and checks its header and directory (O(1) in the file size).
+    /// Memory-maps `path`, checks its header and directory and decodes its placement record
+    /// (O(1) in the file size).
     ///
     /// This is the one place obbtree maps files. The map is read-only and private to this
     /// value; every later read goes through checked slices of it.
@@ -231,7 +239,15 @@ impl ObbtFile {
         self.precision
     }
 
-    /// What the header says about the tree (reads no section).
+    /// How the stored coordinates were made from the input mesh's: `stored = scale · input +
+    /// offset` ([`Placement::IDENTITY`] when the file has no `placement` section). Decoded on
+    /// open, unverified: [`ObbtFile::verify`] checks that it is finite with a scale above 0.
+    pub fn placement(&self) -> Placement {
+        self.placement
+    }
+
+    /// What the header says about the tree, with the placement decoded on open (reads no
+    /// section).
     pub fn info(&self) -> Info {
         let h = &self.header;
         Info {
@@ -250,13 +266,15 @@ impl ObbtFile {
             degenerate_triangles: h.degenerate_triangles.get(),
             bounds_min: h.bounds_min.map(|v| v.get()),
             bounds_max: h.bounds_max.map(|v| v.get()),
+            placement: self.placement,
             file_bytes: h.file_bytes.get(),
             sections: self.sections.clone(),
         }
     }
 
     /// The O(n) checks of the spec: section checksums, zero padding, indices in bounds, a
-    /// well-formed tree, finite values, and every volume containing the vertices below it.
+    /// well-formed tree, finite values, a placement with a finite scale above 0, and every
+    /// volume containing the vertices below it.
     pub fn verify(&self) -> Result<(), VerifyError> {
         super::verify::verify(self)
     }
@@ -281,7 +299,7 @@ impl ObbtFile {
             kind: kind.name().into(),
             problem: p.into(),
         };
-        let [vertices, faces, source_ids, nodes] = SectionKind::ALL;
+        let [vertices, faces, source_ids, nodes] = SectionKind::REQUIRED;
         let section = |k: usize, kind: SectionKind| {
             self.required
                 .get(k)
@@ -338,6 +356,7 @@ impl ObbtFile {
             precision: checked.precision,
             encoding: checked.encoding,
             fit: checked.fit,
+            placement: checked.placement,
         })
     }
 }
@@ -350,6 +369,7 @@ struct Checked {
     precision: Precision,
     encoding: Encoding,
     fit: FitMethod,
+    placement: Placement,
 }
 
 /// The O(1) checks: signature, version, header CRC, declared length, tags and counts, and a
@@ -449,11 +469,14 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
                 u64::from(header.nodes.get()),
                 u32::try_from(node_size(bv, precision)).unwrap_or(u32::MAX),
             ),
+            SectionKind::Placement => (1, PLACEMENT_STRIDE),
         }
     };
     let data_start = align_up(header_bytes as u64).unwrap_or(u64::MAX);
     let mut sections = Vec::with_capacity(usize::from(count));
-    let mut required: [Option<Range<usize>>; 4] = Default::default();
+    // The byte range of each known kind found, in [`SectionKind::ALL`] order.
+    let mut found: [Option<Range<usize>>; SectionKind::ALL.len()] = Default::default();
+    let mut placement = Placement::IDENTITY;
     for (index, raw) in directory.chunks_exact(ENTRY_SIZE).enumerate() {
         let e = SectionEntry::read_from_bytes(raw).map_err(|_| too_short(header_bytes as u64))?;
         let info = SectionInfo {
@@ -499,7 +522,7 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             }
             None => {}
             Some(kind) => {
-                let slot = required
+                let slot = found
                     .iter_mut()
                     .zip(SectionKind::ALL)
                     .find_map(|(slot, k)| (k == kind).then_some(slot))
@@ -519,6 +542,14 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
                 else {
                     return Err(bad("out of the address space".into()));
                 };
+                if kind == SectionKind::Placement {
+                    // One 32-byte record (count and stride checked just above): O(1).
+                    placement = bytes
+                        .get(start..end)
+                        .and_then(|record| PlacementRecord::read_from_bytes(record).ok())
+                        .map(Placement::from)
+                        .ok_or_else(|| bad("cannot be read as a placement record".into()))?;
+                }
                 *slot = Some(start..end);
             }
         }
@@ -542,9 +573,16 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             }
         }
     }
+    let range_of = |kind: SectionKind| {
+        SectionKind::ALL
+            .iter()
+            .zip(&found)
+            .find_map(|(&k, range)| (k == kind).then(|| range.clone()))
+            .flatten()
+    };
     let mut ranges: [Range<usize>; 4] = Default::default();
-    for ((range, slot), kind) in ranges.iter_mut().zip(required).zip(SectionKind::ALL) {
-        *range = slot.ok_or(FormatError::MissingSection(kind.name()))?;
+    for (range, kind) in ranges.iter_mut().zip(SectionKind::REQUIRED) {
+        *range = range_of(kind).ok_or(FormatError::MissingSection(kind.name()))?;
     }
     // `triangles` is at least 1 (checked above), and doubling a `u32` fits a `u64`.
     let binary_nodes = u64::from(header.triangles.get())
@@ -565,5 +603,6 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
         precision,
         encoding,
         fit,
+        placement,
     })
 }

@@ -8,6 +8,7 @@ use super::open::{ObbtFile, TreeVisitor};
 use crate::build::TreeStats;
 use crate::bv::BoundingVolume;
 use crate::mesh::triangle_is_degenerate;
+use crate::placement::Placement;
 use crate::real::point_to_f64;
 use crate::tree::{NodeRef, TreeView};
 
@@ -36,8 +37,25 @@ pub(crate) fn verify(file: &ObbtFile) -> Result<(), VerifyError> {
             ));
         }
     }
+    check_placement(file.placement())?;
     file.visit(Contents { file })
         .map_err(|e| VerifyError::new("header", e.to_string()))?
+}
+
+/// The placement (identity when the file has none) must be one a build can apply: a finite
+/// scale above 0 and a finite offset.
+fn check_placement(placement: Placement) -> Result<(), VerifyError> {
+    let bad = |problem: String| VerifyError::new("section placement", problem);
+    if !Placement::is_valid_scale(placement.scale) {
+        return Err(bad(format!(
+            "scale {} is not a finite number greater than 0",
+            placement.scale
+        )));
+    }
+    if placement.offset.iter().any(|c| !c.is_finite()) {
+        return Err(bad(format!("offset {:?} is not finite", placement.offset)));
+    }
+    Ok(())
 }
 
 /// Every byte outside the header, directory and sections must be zero, so that no byte of a

@@ -2,8 +2,8 @@
 
 use super::aligned::AlignedBytes;
 use super::layout::{
-    align_up, header_crc, vertex_stride, Header, SectionEntry, SectionKind, ENTRY_SIZE,
-    FLAG_REQUIRED, HEADER_SIZE, SIGNATURE, VERSION_MAJOR, VERSION_MINOR,
+    align_up, header_crc, vertex_stride, Header, PlacementRecord, SectionEntry, SectionKind,
+    ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, PLACEMENT_STRIDE, SIGNATURE, VERSION_MAJOR,
 };
 use super::open::ObbtFile;
 use crate::build::{BuildError, BuildOptions, BuiltTree};
@@ -16,10 +16,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 use zerocopy::IntoBytes;
 
-/// Number of sections the writer lays out: the four required ones.
-const SECTIONS: usize = SectionKind::ALL.len();
-/// Bytes of header plus directory.
-const HEADER_BYTES: usize = HEADER_SIZE + ENTRY_SIZE * SECTIONS;
+/// Number of required sections, laid out first.
+const REQUIRED: usize = SectionKind::REQUIRED.len();
 
 /// The error for a size this platform cannot address, or a count the format cannot hold.
 fn too_large(what: &str) -> BuildError {
@@ -41,8 +39,10 @@ pub(crate) fn serialize<B: BoundingVolume>(
     options: &BuildOptions,
 ) -> Result<ObbtFile, BuildError> {
     let scalar = std::mem::size_of::<B::Real>();
+    // The optional placement record, written only when it says something.
+    let placement = (!tree.placement.is_identity()).then(|| PlacementRecord::from(tree.placement));
     // (kind, count, stride) in file order; the byte length of each is count * stride.
-    let sections = [
+    let mut sections = vec![
         (
             SectionKind::Vertices,
             tree.vertices.len() as u64,
@@ -56,19 +56,26 @@ pub(crate) fn serialize<B: BoundingVolume>(
             u32::try_from(Node::<B>::SIZE).map_err(|_| too_large("the node size"))?,
         ),
     ];
+    if placement.is_some() {
+        sections.push((SectionKind::Placement, 1, PLACEMENT_STRIDE));
+    }
+    let header_bytes = ENTRY_SIZE
+        .checked_mul(sections.len())
+        .and_then(|directory| directory.checked_add(HEADER_SIZE))
+        .ok_or_else(|| too_large("the header"))?;
 
     // Sizes come from the mesh, so every step is checked: on a 32-bit host a large mesh
     // can exceed the address space.
-    let mut offset = align_up(HEADER_BYTES as u64).ok_or_else(|| too_large("the header"))?;
-    let mut ranges: [Range<usize>; SECTIONS] = Default::default();
-    for (range, &(kind, count, stride)) in ranges.iter_mut().zip(&sections) {
+    let mut offset = align_up(header_bytes as u64).ok_or_else(|| too_large("the header"))?;
+    let mut ranges: Vec<Range<usize>> = Vec::with_capacity(sections.len());
+    for &(kind, count, stride) in &sections {
         let end = count
             .checked_mul(u64::from(stride))
             .and_then(|length| offset.checked_add(length));
         let (Ok(start), Some(Ok(end))) = (usize::try_from(offset), end.map(usize::try_from)) else {
             return Err(too_large(kind.name()));
         };
-        *range = start..end;
+        ranges.push(start..end);
         offset = align_up(end as u64).ok_or_else(|| too_large(kind.name()))?;
     }
     let total = offset;
@@ -80,8 +87,12 @@ pub(crate) fn serialize<B: BoundingVolume>(
     let bytes = image.as_mut_bytes();
 
     let layout_error = || BuildError::Image("sections out of bounds".into());
+    let required: [Range<usize>; REQUIRED] = ranges
+        .get(..REQUIRED)
+        .and_then(|r| r.to_vec().try_into().ok())
+        .ok_or_else(layout_error)?;
     let [vertices, faces, ids, nodes] = bytes
-        .get_disjoint_mut(ranges.clone())
+        .get_disjoint_mut(required)
         .map_err(|_| layout_error())?;
     let chunks = vertices.chunks_exact_mut(scalar);
     for (out, v) in chunks.zip(tree.vertices.iter().flatten()) {
@@ -93,12 +104,20 @@ pub(crate) fn serialize<B: BoundingVolume>(
     for (out, i) in ids.chunks_exact_mut(4).zip(&tree.source_ids) {
         out.copy_from_slice(&i.to_le_bytes());
     }
-    let crcs = [
+    let mut crcs = vec![
         crc32fast::hash(vertices),
         crc32fast::hash(faces),
         crc32fast::hash(ids),
         write_nodes(tree, nodes)?,
     ];
+    if let Some(record) = placement {
+        let out = ranges
+            .get(REQUIRED)
+            .and_then(|range| bytes.get_mut(range.clone()))
+            .ok_or_else(layout_error)?;
+        out.copy_from_slice(record.as_bytes());
+        crcs.push(crc32fast::hash(out));
+    }
 
     let entries: Vec<SectionEntry> = sections
         .iter()
@@ -106,7 +125,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         .zip(crcs)
         .map(|((&(kind, count, stride), range), crc)| SectionEntry {
             kind: kind.tag().into(),
-            flags: FLAG_REQUIRED.into(),
+            flags: if kind.is_required() { FLAG_REQUIRED } else { 0 }.into(),
             offset: (range.start as u64).into(),
             length: (range.len() as u64).into(),
             count: count.into(),
@@ -121,8 +140,14 @@ pub(crate) fn serialize<B: BoundingVolume>(
     let mut header = Header {
         signature: SIGNATURE,
         version_major: VERSION_MAJOR.into(),
-        version_minor: VERSION_MINOR.into(),
-        header_bytes: count32(HEADER_BYTES, "the header")?.into(),
+        // The lowest minor version that defines every section written.
+        version_minor: sections
+            .iter()
+            .map(|&(kind, ..)| kind.minor_version())
+            .max()
+            .unwrap_or_default()
+            .into(),
+        header_bytes: count32(header_bytes, "the header")?.into(),
         file_bytes: total.into(),
         bv_kind: options.bv.tag(),
         precision: options.precision.tag(),
@@ -131,7 +156,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         leaf_size: u16::try_from(options.leaf_size)
             .map_err(|_| BuildError::LeafSize(options.leaf_size))?
             .into(),
-        section_count: u16::try_from(SECTIONS)
+        section_count: u16::try_from(sections.len())
             .map_err(|_| too_large("the section count"))?
             .into(),
         triangles: count32(tree.faces.len(), "the triangle count")?.into(),

@@ -133,6 +133,17 @@ pub fn entry_offset(index: usize) -> usize {
     HEADER_SIZE + ENTRY_SIZE * index
 }
 
+/// Byte offset and width of the field named `field` (see [`ENTRY_FIELDS`]) of directory
+/// entry `index`.
+pub fn entry_field(index: usize, field: &str) -> (usize, usize) {
+    let (_, at, width) = ENTRY_FIELDS
+        .iter()
+        .find(|(name, _, _)| *name == field)
+        .copied()
+        .expect("a directory entry field");
+    (entry_offset(index) + at, width)
+}
+
 /// Where an image was stopped, or that it answered.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Outcome {
