@@ -48,17 +48,6 @@ fn cylinder(radius: f64, half_height: f64, sides: u32) -> TriMesh {
     TriMesh::new(vertices, faces).expect("valid cylinder")
 }
 
-fn obj(mesh: &TriMesh) -> String {
-    let mut text = String::new();
-    for v in mesh.vertices() {
-        writeln!(text, "v {} {} {}", v[0], v[1], v[2]).unwrap();
-    }
-    for f in mesh.faces() {
-        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
-    }
-    text
-}
-
 /// A pose as 12 numbers: rotation row-major, then translation.
 fn pose(r: &Matrix3<f64>, t: &Vector3<f64>) -> String {
     let v: Vec<String> = (0..9)
@@ -159,7 +148,7 @@ fn main() {
     ];
     let options = BuildOptions::default();
     for (name, mesh) in &meshes {
-        std::fs::write(dir.join(format!("{name}.obj")), obj(mesh)).unwrap();
+        std::fs::write(dir.join(format!("{name}.obj")), common::obj_text(mesh)).unwrap();
         let tree = build(mesh, &options, None).unwrap();
         tree.write_atomic(dir.join(format!("{name}.obbt"))).unwrap();
     }

@@ -518,16 +518,11 @@ fn temporaries(dir: &Path) -> Vec<String> {
 
 /// Writes a lat/long sphere of `2 * slices * (stacks - 1)` triangles as OBJ.
 fn write_sphere_obj(path: &Path, stacks: u32, slices: u32) {
-    use std::fmt::Write as _;
-    let mesh = common::uv_sphere(1.0, stacks, slices);
-    let mut text = String::new();
-    for v in mesh.vertices() {
-        writeln!(text, "v {} {} {}", v[0], v[1], v[2]).unwrap();
-    }
-    for f in mesh.faces() {
-        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
-    }
-    std::fs::write(path, text).unwrap();
+    std::fs::write(
+        path,
+        common::obj_text(&common::uv_sphere(1.0, stacks, slices)),
+    )
+    .unwrap();
 }
 
 fn interrupt(child: &std::process::Child, signal: &str) {
@@ -757,18 +752,15 @@ fn flags_that_cannot_apply_and_readable_numbers() {
 /// Writes the bundled cow as an OBJ in `dir`, every vertex `p` written as `factor · p + shift`
 /// (shortest round-trip decimals), same faces.
 fn cow_in_other_units(dir: &Path, factor: f64, shift: [f64; 3]) -> PathBuf {
-    use std::fmt::Write;
     let mesh = obbtree::mesh::TriMesh::load(Path::new(&cow())).unwrap();
-    let mut text = String::new();
-    for v in mesh.vertices() {
-        let [x, y, z]: [f64; 3] = std::array::from_fn(|k| factor * v[k] + shift[k]);
-        writeln!(text, "v {x:?} {y:?} {z:?}").unwrap();
-    }
-    for f in mesh.faces() {
-        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
-    }
+    let moved = mesh
+        .vertices()
+        .iter()
+        .map(|v| std::array::from_fn(|k| factor * v[k] + shift[k]))
+        .collect();
+    let moved = obbtree::mesh::TriMesh::new(moved, mesh.faces().to_vec()).unwrap();
     let path = dir.join("cow-mm.obj");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, common::obj_text(&moved)).unwrap();
     path
 }
 

@@ -98,6 +98,20 @@ pub fn grid(n: u32) -> TriMesh {
     TriMesh::new(vertices, faces).expect("valid grid")
 }
 
+/// `mesh` as OBJ text: `v` lines (shortest decimals that read back exactly) and 1-based
+/// `f` lines, in order.
+pub fn obj_text(mesh: &TriMesh) -> String {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    for v in mesh.vertices() {
+        writeln!(text, "v {} {} {}", v[0], v[1], v[2]).unwrap();
+    }
+    for f in mesh.faces() {
+        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
+    }
+    text
+}
+
 /// The bundled cow (5,804 triangles), loaded from `assets/`.
 pub fn cow() -> TriMesh {
     TriMesh::load(std::path::Path::new(concat!(
