@@ -10,8 +10,7 @@ use std::io::{BufRead, BufReader, IsTerminal};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// Run a scene: objects moving over frames, every pair getting the effect its rules ask
-/// for, and no more work than that needs.
+/// Run a scene: objects moving over frames, every pair getting the effect its rules ask for, and no more work than that needs
 ///
 /// The scene file (TOML) lists objects and rules; a pair of distinct objects gets the
 /// effect of the last rule that matches it (either order), none without one:
@@ -40,6 +39,7 @@ use std::time::{Duration, Instant};
 ///
 /// Example: obbtree scene assets/scenes/cell.toml --json
 #[derive(Args, Debug)]
+#[command(verbatim_doc_comment)]
 pub struct SceneArgs {
     /// The scene file (TOML).
     pub scene: PathBuf,
