@@ -59,6 +59,45 @@ impl NodeRef {
     }
 }
 
+/// A node's contents, checked against the arrays it points into ([`TreeView::node_kind`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NodeKind {
+    /// Child nodes, all after the parent and inside the node array.
+    Children(Range<u32>),
+    /// Leaf-ordered faces, inside the face array.
+    Faces(Range<u32>),
+}
+
+/// Why a node cannot be used: what a damaged, unverified file can hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeDefect {
+    /// The node index is past the node array.
+    Missing,
+    /// The child range runs past the node array or does not lie after its parent.
+    BadChildren,
+    /// The face range runs past the face array.
+    BadFaces,
+}
+
+impl NodeDefect {
+    /// What is wrong, in a few words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            NodeDefect::Missing => "node index out of bounds",
+            NodeDefect::BadChildren => "child reference out of bounds or backwards",
+            NodeDefect::BadFaces => "leaf face range out of bounds",
+        }
+    }
+}
+
+impl std::fmt::Display for NodeDefect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.describe())
+    }
+}
+
+impl std::error::Error for NodeDefect {}
+
 /// Why a reference cannot be encoded: the model is too large or too wide for the encoding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum EncodeError {
@@ -276,29 +315,49 @@ impl<'a, B: BoundingVolume> TreeView<'a, B> {
         self.encoding.decode(node.packed)
     }
 
+    /// What node `index` holds, checked: its children (which must lie after it and inside
+    /// the node array, so every descent terminates) or its faces (inside the face array).
+    /// The one decoder of references that the traversal, `verify` and the tests share.
+    #[inline]
+    pub fn node_kind(&self, index: u32) -> Result<NodeKind, NodeDefect> {
+        let node = self.node(index).ok_or(NodeDefect::Missing)?;
+        match self.node_ref(node) {
+            NodeRef::Internal { first, count } => {
+                let end = first.checked_add(count).ok_or(NodeDefect::BadChildren)?;
+                if first > index && end as usize <= self.nodes.len() {
+                    Ok(NodeKind::Children(first..end))
+                } else {
+                    Err(NodeDefect::BadChildren)
+                }
+            }
+            NodeRef::Leaf { first, count } => {
+                let end = first.checked_add(count).ok_or(NodeDefect::BadFaces)?;
+                if end as usize <= self.faces.len() {
+                    Ok(NodeKind::Faces(first..end))
+                } else {
+                    Err(NodeDefect::BadFaces)
+                }
+            }
+        }
+    }
+
     /// The children of node `index`, or `None` for a leaf, a missing node, or children
-    /// that are out of bounds or not after their parent (which keeps traversal finite).
+    /// that are out of bounds or not after their parent (see [`TreeView::node_kind`]).
     #[inline]
     pub fn children(&self, index: u32) -> Option<Range<u32>> {
-        match self.node_ref(self.node(index)?) {
-            NodeRef::Internal { first, count } => {
-                let end = first.checked_add(count)?;
-                (first > index && end as usize <= self.nodes.len()).then_some(first..end)
-            }
-            NodeRef::Leaf { .. } => None,
+        match self.node_kind(index) {
+            Ok(NodeKind::Children(range)) => Some(range),
+            _ => None,
         }
     }
 
     /// The faces of leaf `index`, or `None` for an internal node, a missing node, or a face
-    /// range out of bounds.
+    /// range out of bounds (see [`TreeView::node_kind`]).
     #[inline]
     pub fn leaf_faces(&self, index: u32) -> Option<Range<u32>> {
-        match self.node_ref(self.node(index)?) {
-            NodeRef::Leaf { first, count } => {
-                let end = first.checked_add(count)?;
-                (end as usize <= self.faces.len()).then_some(first..end)
-            }
-            NodeRef::Internal { .. } => None,
+        match self.node_kind(index) {
+            Ok(NodeKind::Faces(range)) => Some(range),
+            _ => None,
         }
     }
 

@@ -128,8 +128,19 @@ pub trait BoundingVolume:
     fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool;
 
     /// A lower bound on the distance between this volume and `other` (posed as in
-    /// [`BoundingVolume::overlaps`]); 0 when they may overlap.
-    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64;
+    /// [`BoundingVolume::overlaps`]); 0 when they may overlap. The tightest this volume
+    /// type gives: [`BoundingVolume::distance_lower_bound_until`] with no threshold.
+    #[inline]
+    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
+        self.distance_lower_bound_until(other, xf, f64::INFINITY)
+    }
+
+    /// A lower bound on the distance, as [`BoundingVolume::distance_lower_bound`], whose
+    /// work may stop once it reaches `enough`: a traversal that prunes every pair whose
+    /// bound reaches a threshold needs no tighter bound for those, and most pairs it tests
+    /// are pruned by the cheapest terms. The result is either `>= enough` or the tightest
+    /// bound.
+    fn distance_lower_bound_until(&self, other: &Self, xf: &Transform, enough: f64) -> f64;
 
     /// An upper bound on the largest distance between a point of this volume and a point of
     /// `other` (posed as in [`BoundingVolume::overlaps`]).

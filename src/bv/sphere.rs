@@ -125,7 +125,7 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     }
 
     #[inline]
-    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
+    fn distance_lower_bound_until(&self, other: &Self, xf: &Transform, _enough: f64) -> f64 {
         (self.center_distance(other, xf) - self.radius.to_f64() - other.radius.to_f64()).max(0.0)
     }
 

@@ -128,17 +128,19 @@ impl Distance {
     }
 }
 
-impl<B: BoundingVolume> Policy<B> for Distance {
-    const ORDERED: bool = true;
-
+impl Distance {
+    /// Whether a pair below the limit has been measured: from then on the best answer
+    /// prunes; before, only the limit does (or the error allowance could hide the pairs
+    /// below it, after a warm start beyond it).
     #[inline]
-    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64 {
-        a.distance_lower_bound(b, xf)
+    fn found(&self) -> bool {
+        self.best.faces.is_some() && self.best.distance < self.limit
     }
 
+    /// Whether a volume pair with lower bound `key` may hold a pair closer than the best
+    /// answer by more than the allowances `rel_err` and `abs_err`.
     #[inline]
-    fn keep(&self, key: f64) -> bool {
-        let best = self.best.distance;
+    fn may_improve(&self, key: f64, rel_err: f64, abs_err: f64) -> bool {
         // Until a first pair is measured without a limit nothing is pruned: a pose far
         // enough out overflows every bound to infinity, and the answer is then an infinite
         // distance, not none.
@@ -147,15 +149,51 @@ impl<B: BoundingVolume> Policy<B> for Distance {
         }
         // (NaN keys and bests compare false: a damaged file's pair is pruned.)
         let within_limit = key < self.limit;
-        // No pair below the limit yet (a warm start beyond it): only the limit prunes, or
-        // the error allowance could hide the pairs below it.
-        let found = best < self.limit;
-        if !within_limit || !found {
+        if !within_limit || !self.found() {
             return within_limit;
         }
-        key * (1.0 + self.rel_err) < best
-            && key + self.abs_err < best
-            && key < best * (1.0 - RESOLUTION)
+        let best = self.best.distance;
+        key * (1.0 + rel_err) < best && key + abs_err < best && key < best * (1.0 - RESOLUTION)
+    }
+
+    /// A key at or above which [`Policy::keep`] certainly prunes (the limit while nothing
+    /// else can): the bound of a pair need not be tightened past it.
+    #[inline]
+    fn prune_at(&self) -> f64 {
+        if !self.found() {
+            return self.limit;
+        }
+        let best = self.best.distance;
+        // Each condition of `keep` fails from its own threshold on; the smallest of them
+        // is where the first fails. Rounding in these divisions could only make the
+        // threshold a little high (a little more work), never prune a kept pair: `keep`
+        // still decides on the key itself.
+        (best / (1.0 + self.rel_err))
+            .min(best - self.abs_err)
+            .min(best * (1.0 - RESOLUTION))
+            .min(self.limit)
+    }
+}
+
+impl<B: BoundingVolume> Policy<B> for Distance {
+    const ORDERED: bool = true;
+
+    #[inline]
+    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64 {
+        a.distance_lower_bound_until(b, xf, self.prune_at())
+    }
+
+    #[inline]
+    fn keep(&self, key: f64) -> bool {
+        self.may_improve(key, self.rel_err, self.abs_err)
+    }
+
+    #[inline]
+    fn dive_into(&self, key: f64) -> bool {
+        // Without the error allowances: with them, a dive would end above the best
+        // answer's allowance and never find the closer pair that lets everything else
+        // be pruned.
+        self.may_improve(key, 0.0, 0.0)
     }
 
     #[inline]

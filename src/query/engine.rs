@@ -12,8 +12,10 @@ use super::triangle::Triangle;
 use super::QueryError;
 use crate::bv::pair::Transform;
 use crate::bv::BoundingVolume;
-use crate::tree::TreeView;
+use crate::tree::{NodeDefect, NodeKind, TreeView};
 use nalgebra::Vector3;
+use std::collections::BinaryHeap;
+use std::ops::Range;
 
 /// What a policy says after a triangle pair: go on, or stop the whole traversal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,6 +34,15 @@ pub(crate) trait Policy<B: BoundingVolume> {
     /// Whether a pair with this key still matters (checked when it is taken off the stack,
     /// since the best answer may have improved since it was pushed).
     fn keep(&self, key: f64) -> bool;
+    /// Whether a dive of an ordered traversal continues into a child with this key: by
+    /// default when it is kept. A distance query with an error allowance dives while the
+    /// child could still be closer than the best answer, and applies the allowance only to
+    /// the pairs it takes off the heap: so it looks for a better answer wherever a dive
+    /// is cheap, and stops once the allowance covers everything waiting.
+    #[inline]
+    fn dive_into(&self, key: f64) -> bool {
+        self.keep(key)
+    }
     /// Tests one triangle pair (A's triangle in A's frame, B's mapped into it).
     /// `face_a` / `face_b` are leaf-ordered face indices.
     fn triangles(
@@ -52,13 +63,79 @@ pub(crate) struct Pending {
     key: f64,
 }
 
+/// Pending pairs of an ordered traversal, smallest key on top.
+impl PartialEq for Pending {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == std::cmp::Ordering::Equal
+    }
+}
+
+impl Eq for Pending {}
+
+impl PartialOrd for Pending {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Pending {
+    /// Reversed on the key (so `BinaryHeap`, a max-heap, pops the smallest), then on the
+    /// node indices, so that the order of a traversal never depends on the heap's layout.
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        other
+            .key
+            .total_cmp(&self.key)
+            .then(other.a.cmp(&self.a))
+            .then(other.b.cmp(&self.b))
+    }
+}
+
 /// Reusable scratch of the traversal: keep one per thread and pass it to every query to
 /// avoid allocating.
 #[derive(Debug, Default)]
 pub struct QueryContext {
+    /// Pairs waiting in a collision traversal (depth first).
     pub(crate) stack: Vec<Pending>,
+    /// Pairs waiting in an ordered traversal (best first).
+    pub(crate) heap: BinaryHeap<Pending>,
     /// Contacting leaf-ordered face pairs of the running collision query.
     pub(crate) faces: Vec<(u32, u32)>,
+}
+
+/// The pairs waiting in a traversal: a stack (depth first) for unordered policies, a heap
+/// (best first: the smallest key next) for ordered ones.
+trait Waiting {
+    fn put(&mut self, pending: Pending);
+    fn take(&mut self) -> Option<Pending>;
+    fn len(&self) -> usize;
+}
+
+impl Waiting for Vec<Pending> {
+    #[inline(always)]
+    fn put(&mut self, pending: Pending) {
+        self.push(pending);
+    }
+    #[inline(always)]
+    fn take(&mut self) -> Option<Pending> {
+        self.pop()
+    }
+    fn len(&self) -> usize {
+        Vec::len(self)
+    }
+}
+
+impl Waiting for BinaryHeap<Pending> {
+    #[inline(always)]
+    fn put(&mut self, pending: Pending) {
+        self.push(pending);
+    }
+    #[inline(always)]
+    fn take(&mut self) -> Option<Pending> {
+        self.pop()
+    }
+    fn len(&self) -> usize {
+        BinaryHeap::len(self)
+    }
 }
 
 impl QueryContext {
@@ -88,6 +165,17 @@ fn triangle<B: BoundingVolume>(
 }
 
 /// Runs the tandem traversal of `a` and `b` (B mapped into A's frame by `xf`).
+///
+/// Unordered policies (collision) go depth first and test a pair when it is taken, as
+/// RAPID's recursion does: a first-contact query that stops never tests the pairs still
+/// waiting. Ordered policies (distance, span) key a pair when it is pushed and dive: each
+/// expansion continues with its smallest-keyed child down to a triangle pair (a first
+/// answer to prune with, one step per level), the other children wait on a heap, and the
+/// next dive starts from the smallest key waiting, wherever in the trees it is. The
+/// traversal ends as soon as that smallest key is pruned, since every other key waiting
+/// is at least as large. (A depth-first order instead resumes from the last sibling
+/// pushed: when its first answer was barely within `rel_err`, it proved thousands of
+/// nearly-as-close pairs too far before trying the closer ones.)
 pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     a: &TreeView<'_, B>,
     b: &TreeView<'_, B>,
@@ -96,43 +184,101 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     policy: &mut P,
     context: &mut QueryContext,
 ) -> Result<Stats, QueryError> {
+    if P::ORDERED {
+        let heap = &mut context.heap;
+        heap.clear();
+        let (Some(ra), Some(rb)) = (a.node(0), b.node(0)) else {
+            return Err(corrupt('A', NodeDefect::Missing));
+        };
+        let key = ordered_key(policy.key(&ra.bv, &rb.bv, xf));
+        heap.push(Pending { a: 0, b: 0, key });
+        descend(a, b, xf, rule, policy, heap)
+    } else {
+        let stack = &mut context.stack;
+        stack.clear();
+        stack.push(Pending {
+            a: 0,
+            b: 0,
+            key: 0.0,
+        });
+        descend(a, b, xf, rule, policy, stack)
+    }
+}
+
+fn corrupt(which: char, defect: NodeDefect) -> QueryError {
+    QueryError::CorruptTree {
+        which,
+        what: defect.describe(),
+    }
+}
+
+/// A key as the heap orders it: NaN (a damaged, unverified file) as +∞, so that it is
+/// taken last and `keep` decides on it as on any large key, never first.
+#[inline(always)]
+fn ordered_key(key: f64) -> f64 {
+    if key.is_nan() {
+        f64::INFINITY
+    } else {
+        key
+    }
+}
+
+/// The traversal loop over `waiting` (see [`traverse`]).
+fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
+    a: &TreeView<'_, B>,
+    b: &TreeView<'_, B>,
+    xf: &Transform,
+    rule: DescentRule,
+    policy: &mut P,
+    waiting: &mut W,
+) -> Result<Stats, QueryError> {
     let mut stats = Stats::default();
-    let corrupt = |which, what| QueryError::CorruptTree { which, what };
-    let (Some(root_a), Some(root_b)) = (a.node(0), b.node(0)) else {
-        return Err(corrupt('A', "no root node"));
-    };
     // A tree visits each node pair at most once; more means shared children (a corrupt,
     // unverified file), which could otherwise take exponential time.
     let limit = (a.nodes().len() as u64).saturating_mul(b.nodes().len() as u64);
-    let stack = &mut context.stack;
-    stack.clear();
-    stack.push(Pending {
-        a: 0,
-        b: 0,
-        key: policy.key(&root_a.bv, &root_b.bv, xf),
-    });
-    while let Some(Pending { a: ia, b: ib, key }) = stack.pop() {
+    // The child a dive continues with, taken before anything waiting.
+    let mut dive: Option<Pending> = None;
+    loop {
+        let from_dive = dive.is_some();
+        let Some(Pending { a: ia, b: ib, key }) = dive.take().or_else(|| waiting.take()) else {
+            break;
+        };
         stats.nodes_visited += 1;
         if stats.nodes_visited > limit {
-            return Err(corrupt('A', "a node is reachable along two paths"));
+            return Err(QueryError::CorruptTree {
+                which: 'A',
+                what: "a node is reachable along two paths",
+            });
         }
-        if !policy.keep(key) {
+        let na = a.node(ia).ok_or(corrupt('A', NodeDefect::Missing))?;
+        let nb = b.node(ib).ok_or(corrupt('B', NodeDefect::Missing))?;
+        let key = if P::ORDERED {
+            key
+        } else {
+            policy.key(&na.bv, &nb.bv, xf)
+        };
+        let kept = if from_dive {
+            policy.dive_into(key)
+        } else {
+            policy.keep(key)
+        };
+        if !kept {
             stats.bv_disjoint += 1;
+            if P::ORDERED && !from_dive {
+                // The smallest key waiting is pruned, so is every other: they were all
+                // tested when pushed, and count as pruned pairs taken off.
+                let rest = waiting.len() as u64;
+                stats.bv_disjoint += rest;
+                stats.nodes_visited += rest;
+                break;
+            }
             continue;
         }
         stats.bv_overlap += 1;
-        let na = a.node(ia).ok_or(corrupt('A', "node index out of bounds"))?;
-        let nb = b.node(ib).ok_or(corrupt('B', "node index out of bounds"))?;
-        let children_a = a.children(ia);
-        let children_b = b.children(ib);
-        let descend_a = match (&children_a, &children_b) {
-            (None, None) => {
-                let faces_a = a
-                    .leaf_faces(ia)
-                    .ok_or(corrupt('A', "leaf face range out of bounds"))?;
-                let faces_b = b
-                    .leaf_faces(ib)
-                    .ok_or(corrupt('B', "leaf face range out of bounds"))?;
+        let kind_a = a.node_kind(ia).map_err(|d| corrupt('A', d))?;
+        let kind_b = b.node_kind(ib).map_err(|d| corrupt('B', d))?;
+        match (kind_a, kind_b) {
+            (NodeKind::Faces(faces_a), NodeKind::Faces(faces_b)) => {
                 for fa in faces_a {
                     let ta = triangle(a, fa, None, 'A')?;
                     for fb in faces_b.clone() {
@@ -142,61 +288,98 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
                         }
                     }
                 }
-                continue;
             }
-            (Some(_), None) => true,
-            (None, Some(_)) => false,
-            (Some(_), Some(_)) => rule.descend_a(&na.bv, &nb.bv),
-        };
-        // Children of an internal node that `children` refused (out of bounds, or not after
-        // the parent) are a corrupt tree, not a leaf.
-        if children_a.is_none() && a.leaf_faces(ia).is_none() {
-            return Err(corrupt('A', "child reference out of bounds or backwards"));
-        }
-        if children_b.is_none() && b.leaf_faces(ib).is_none() {
-            return Err(corrupt('B', "child reference out of bounds or backwards"));
-        }
-        let start = stack.len();
-        if descend_a {
-            for c in children_a.into_iter().flatten() {
-                let child = a.node(c).ok_or(corrupt('A', "child index out of bounds"))?;
-                stack.push(Pending {
-                    a: c,
-                    b: ib,
-                    key: policy.key(&child.bv, &nb.bv, xf),
-                });
+            (NodeKind::Children(children), NodeKind::Faces(_)) => {
+                dive = push_a(a, children, &nb.bv, ib, xf, policy, waiting)?
             }
-        } else {
-            for c in children_b.into_iter().flatten() {
-                let child = b.node(c).ok_or(corrupt('B', "child index out of bounds"))?;
-                stack.push(Pending {
-                    a: ia,
-                    b: c,
-                    key: policy.key(&na.bv, &child.bv, xf),
-                });
+            (NodeKind::Faces(_), NodeKind::Children(children)) => {
+                dive = push_b(b, children, &na.bv, ia, xf, policy, waiting)?
             }
-        }
-        if P::ORDERED {
-            // Most promising last, so it is popped first.
-            if let Some(tail) = stack.get_mut(start..) {
-                sort_descending(tail);
+            (NodeKind::Children(children_a), NodeKind::Children(children_b)) => {
+                dive = if rule.descend_a(&na.bv, &nb.bv) {
+                    push_a(a, children_a, &nb.bv, ib, xf, policy, waiting)?
+                } else {
+                    push_b(b, children_b, &na.bv, ia, xf, policy, waiting)?
+                }
             }
         }
     }
     Ok(stats)
 }
 
-/// Sorts pending pairs by decreasing key, stably. Children counts are small (2 in binary
-/// trees), so an insertion sort is cheapest.
+/// For an ordered policy, the smaller-keyed of `dive` and `pair`, the other put waiting
+/// (the traversal continues with the closest child at once: a greedy dive that reaches a
+/// triangle pair, and a first answer to prune with, in one step per level). Unordered
+/// policies put every pair waiting.
 #[inline(always)]
-// why: `j - 1` and `j` lie in `0..tail.len()` (`1 <= j <= i < tail.len()`).
-#[allow(clippy::indexing_slicing)]
-fn sort_descending(tail: &mut [Pending]) {
-    for i in 1..tail.len() {
-        let mut j = i;
-        while j > 0 && tail[j - 1].key < tail[j].key {
-            tail.swap(j - 1, j);
-            j -= 1;
-        }
+fn keep_smaller<P: Policy<B>, B: BoundingVolume>(
+    dive: Option<Pending>,
+    pair: Pending,
+    waiting: &mut impl Waiting,
+) -> Option<Pending> {
+    if !P::ORDERED {
+        waiting.put(pair);
+        return None;
     }
+    match dive {
+        Some(d) if d.key <= pair.key => {
+            waiting.put(pair);
+            Some(d)
+        }
+        Some(d) => {
+            waiting.put(d);
+            Some(pair)
+        }
+        None => Some(pair),
+    }
+}
+
+/// Pushes the pairs of A's `children` with B's node `ib` (volume `bv_b`), keyed now if the
+/// policy is ordered.
+#[inline(always)]
+fn push_a<B: BoundingVolume, P: Policy<B>>(
+    a: &TreeView<'_, B>,
+    children: Range<u32>,
+    bv_b: &B,
+    ib: u32,
+    xf: &Transform,
+    policy: &P,
+    waiting: &mut impl Waiting,
+) -> Result<Option<Pending>, QueryError> {
+    let mut dive = None;
+    for c in children {
+        let key = if P::ORDERED {
+            let child = a.node(c).ok_or(corrupt('A', NodeDefect::Missing))?;
+            ordered_key(policy.key(&child.bv, bv_b, xf))
+        } else {
+            0.0
+        };
+        dive = keep_smaller::<P, B>(dive, Pending { a: c, b: ib, key }, waiting);
+    }
+    Ok(dive)
+}
+
+/// Pushes the pairs of A's node `ia` (volume `bv_a`) with B's `children`, keyed now if the
+/// policy is ordered.
+#[inline(always)]
+fn push_b<B: BoundingVolume, P: Policy<B>>(
+    b: &TreeView<'_, B>,
+    children: Range<u32>,
+    bv_a: &B,
+    ia: u32,
+    xf: &Transform,
+    policy: &P,
+    waiting: &mut impl Waiting,
+) -> Result<Option<Pending>, QueryError> {
+    let mut dive = None;
+    for c in children {
+        let key = if P::ORDERED {
+            let child = b.node(c).ok_or(corrupt('B', NodeDefect::Missing))?;
+            ordered_key(policy.key(bv_a, &child.bv, xf))
+        } else {
+            0.0
+        };
+        dive = keep_smaller::<P, B>(dive, Pending { a: ia, b: c, key }, waiting);
+    }
+    Ok(dive)
 }

@@ -37,6 +37,9 @@ pub struct PairQuery<'f> {
     a: &'f ObbtFile,
     b: &'f ObbtFile,
     context: QueryContext,
+    /// The pair buffer of first-contact queries, kept so that a yes/no query per frame
+    /// allocates nothing.
+    first: CollideResult,
 }
 
 impl<'f> PairQuery<'f> {
@@ -46,6 +49,7 @@ impl<'f> PairQuery<'f> {
             a,
             b,
             context: QueryContext::new(),
+            first: CollideResult::default(),
         }))
     }
 
@@ -105,13 +109,11 @@ impl<'f> PairQuery<'f> {
             first_contact: true,
             ..CollideOptions::default()
         };
-        let mut result = CollideResult {
-            colliding: false,
-            pairs: Vec::with_capacity(1),
-            stats: Stats::default(),
-        };
-        self.collide_into(pose_a, pose_b, &options, &mut result)?;
-        Ok((result.pairs.first().copied(), result.stats))
+        let mut result = std::mem::take(&mut self.first);
+        let outcome = self.collide_into(pose_a, pose_b, &options, &mut result);
+        let answer = (result.pairs.first().copied(), result.stats);
+        self.first = result;
+        outcome.map(|()| answer)
     }
 
     /// The distance, exact or within the errors of `options`.
