@@ -1,7 +1,8 @@
 //! Runs one query kind many times on the sliding spheres, for profilers (perf, callgrind).
 //!
 //! `cargo run --release --example profile_query -- KIND X RUNS [DIR]` with KIND one of
-//! `all`, `first`, `distance`, `rel` (rel_err 0.01), `culled`; X the sliding position
+//! `all`, `first`, `distance`, `rel` (rel_err 0.01), `culled`, `concentric` (exact
+//! distance, spheres of radii 1 and 1.05); X the sliding position
 //! (0.2 … 2.2), or with DIR (a case kept by `OBBTREE_PEERS_KEEP=1 cargo bench --bench
 //! peers`: `a.obj`, `b.obj`, `poses.txt`) the index of a pose line. Prints the work of one
 //! query and the median time per query.
@@ -46,6 +47,7 @@ fn main() {
             (pose(&v[..12]), pose(&v[12..]))
         }
         (None, "culled") => (Pose::identity(), Pose::translation(10.0, 0.0, 0.0)),
+        (None, "concentric") => (Pose::identity(), Pose::identity()),
         (None, _) => (Pose::identity(), common::sliding_pose(x, 5)),
     };
     let mut buffer = Default::default();
@@ -60,7 +62,7 @@ fn main() {
         let (here, there) = std::hint::black_box((&here, &there));
         match kind {
             "first" | "culled" => pair.first_contact_stats(here, there).expect("q").1,
-            "distance" => pair.distance(here, there, &exact).expect("q").stats,
+            "distance" | "concentric" => pair.distance(here, there, &exact).expect("q").stats,
             "rel" => pair.distance(here, there, &rel).expect("q").stats,
             _ => {
                 pair.collide_into(here, there, &all, &mut buffer)

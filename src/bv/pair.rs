@@ -42,7 +42,7 @@ pub const OFFSET_ROUNDING: f64 = 64.0 * f64::EPSILON;
 /// Alternating projections after the first pair in [`BoxPair::closest_direction_gap`]:
 /// each costs about 40 flops; more steps tighten the bound a little (bunny and sliding
 /// spheres: 2 to 10% fewer pairs per extra step) and cost more than they save.
-const PROJECTION_STEPS: usize = 2;
+const PROJECTION_STEPS: usize = 1;
 /// How near the closest-direction gap must come to the distance of the points it was
 /// taken between (at least the box distance) for the edge-edge axes to be skipped: they
 /// could then raise the bound by at most 10%.

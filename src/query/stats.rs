@@ -16,7 +16,10 @@ pub struct Stats {
     pub tri_separated: u64,
     /// K: triangle pair tests whose triangles touch.
     pub tri_contact: u64,
-    /// Node pairs taken off the traversal stack (each reads one node of each tree).
+    /// Node pairs a traversal decided on: taken off its stack or heap, each reading one
+    /// node of each tree. When a distance or span traversal ends because the smallest key
+    /// waiting is pruned, the pairs still waiting count here and in D (each was tested when
+    /// it was pushed), so `D + I` stays the number of pair tests and the identity holds.
     pub nodes_visited: u64,
 }
 
