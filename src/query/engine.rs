@@ -197,9 +197,10 @@ fn triangle<B: BoundingVolume>(
 /// answer to prune with, one step per level), the other children wait on a heap, and the
 /// next dive starts from the smallest key waiting, wherever in the trees it is (up to the
 /// [`Frontier`]'s heap size). The traversal ends as soon as that smallest key is pruned,
-/// since every other key waiting is at least as large. (A depth-first order instead resumes from the last sibling
-/// pushed: when its first answer was barely within `rel_err`, it proved thousands of
-/// nearly-as-close pairs too far before trying the closer ones.)
+/// since every other key waiting is at least as large. (A depth-first order instead
+/// resumes from the last sibling pushed: when its first answer was barely within
+/// `rel_err`, it proved thousands of nearly-as-close pairs too far before trying the
+/// closer ones.)
 pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     a: &TreeView<'_, B>,
     b: &TreeView<'_, B>,
@@ -322,16 +323,16 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 }
             }
             (NodeKind::Children(children), NodeKind::Faces(_)) => {
-                dive = push_a(a, children, &nb.bv, ib, xf, policy, waiting)?
+                dive = push_children(a, Side::A, children, &nb.bv, ib, xf, policy, waiting)?
             }
             (NodeKind::Faces(_), NodeKind::Children(children)) => {
-                dive = push_b(b, children, &na.bv, ia, xf, policy, waiting)?
+                dive = push_children(b, Side::B, children, &na.bv, ia, xf, policy, waiting)?
             }
             (NodeKind::Children(children_a), NodeKind::Children(children_b)) => {
                 dive = if rule.descend_a(&na.bv, &nb.bv) {
-                    push_a(a, children_a, &nb.bv, ib, xf, policy, waiting)?
+                    push_children(a, Side::A, children_a, &nb.bv, ib, xf, policy, waiting)?
                 } else {
-                    push_b(b, children_b, &na.bv, ia, xf, policy, waiting)?
+                    push_children(b, Side::B, children_b, &na.bv, ia, xf, policy, waiting)?
                 }
             }
         }
@@ -366,39 +367,34 @@ fn keep_smaller<P: Policy<B>, B: BoundingVolume>(
     }
 }
 
-/// Pushes the pairs of A's `children` with B's node `ib` (volume `bv_b`), keyed now if the
-/// policy is ordered.
-#[inline(always)]
-fn push_a<B: BoundingVolume, P: Policy<B>>(
-    a: &TreeView<'_, B>,
-    children: Range<u32>,
-    bv_b: &B,
-    ib: u32,
-    xf: &Transform,
-    policy: &P,
-    waiting: &mut impl Waiting,
-) -> Result<Option<Pending>, QueryError> {
-    let mut dive = None;
-    for c in children {
-        let key = if P::ORDERED {
-            let child = a.node(c).ok_or(corrupt('A', NodeDefect::Missing))?;
-            ordered_key(policy.key(&child.bv, bv_b, xf))
-        } else {
-            0.0
-        };
-        dive = keep_smaller::<P, B>(dive, Pending { a: c, b: ib, key }, waiting);
-    }
-    Ok(dive)
+/// Which tree a step descends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    A,
+    B,
 }
 
-/// Pushes the pairs of A's node `ia` (volume `bv_a`) with B's `children`, keyed now if the
-/// policy is ordered.
+impl Side {
+    /// The tree's letter in errors.
+    fn letter(self) -> char {
+        match self {
+            Side::A => 'A',
+            Side::B => 'B',
+        }
+    }
+}
+
+/// Puts the pairs of `side`'s `children` (nodes of `tree`) with the other tree's node
+/// `other` (volume `other_bv`) waiting, keyed now if the policy is ordered; returns the
+/// child pair a dive continues with (see [`keep_smaller`]).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn push_b<B: BoundingVolume, P: Policy<B>>(
-    b: &TreeView<'_, B>,
+fn push_children<B: BoundingVolume, P: Policy<B>>(
+    tree: &TreeView<'_, B>,
+    side: Side,
     children: Range<u32>,
-    bv_a: &B,
-    ia: u32,
+    other_bv: &B,
+    other: u32,
     xf: &Transform,
     policy: &P,
     waiting: &mut impl Waiting,
@@ -406,12 +402,29 @@ fn push_b<B: BoundingVolume, P: Policy<B>>(
     let mut dive = None;
     for c in children {
         let key = if P::ORDERED {
-            let child = b.node(c).ok_or(corrupt('B', NodeDefect::Missing))?;
-            ordered_key(policy.key(bv_a, &child.bv, xf))
+            let child = tree
+                .node(c)
+                .ok_or(corrupt(side.letter(), NodeDefect::Missing))?;
+            ordered_key(match side {
+                Side::A => policy.key(&child.bv, other_bv, xf),
+                Side::B => policy.key(other_bv, &child.bv, xf),
+            })
         } else {
             0.0
         };
-        dive = keep_smaller::<P, B>(dive, Pending { a: ia, b: c, key }, waiting);
+        let pair = match side {
+            Side::A => Pending {
+                a: c,
+                b: other,
+                key,
+            },
+            Side::B => Pending {
+                a: other,
+                b: c,
+                key,
+            },
+        };
+        dive = keep_smaller::<P, B>(dive, pair, waiting);
     }
     Ok(dive)
 }
