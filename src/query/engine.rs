@@ -1,8 +1,9 @@
 //! The one traversal loop behind every query: an iterative tandem descent of two trees
 //! (dissertation Figure 7.9, "any query"), with the query kind plugged in as a policy.
 //!
-//! No recursion and no allocation per test: pairs wait on an explicit stack owned by a
-//! [`QueryContext`] and reused across queries. Every node access goes through the checked
+//! No recursion and no allocation per test: pairs wait on an explicit stack (collision) or
+//! a bounded heap and stack (distance, span: best first) owned by a [`QueryContext`] and
+//! reused across queries. Every node access goes through the checked
 //! accessors of [`TreeView`], so a corrupt, unverified tree ends in an error, not a panic,
 //! and children must follow their parents, so every traversal terminates.
 
@@ -31,8 +32,10 @@ pub(crate) trait Policy<B: BoundingVolume> {
     /// The key of a volume pair: collision uses 0 (may overlap) or infinity (disjoint);
     /// distance a lower bound; span the negated upper bound. Smaller is more promising.
     fn key(&self, a: &B, b: &B, xf: &Transform) -> f64;
-    /// Whether a pair with this key still matters (checked when it is taken off the stack,
-    /// since the best answer may have improved since it was pushed).
+    /// Whether a pair with this key still matters (checked when it is taken off the stack
+    /// or heap, since the best answer may have improved since it was pushed). Monotone: a
+    /// larger key is never kept where a smaller one is not, which lets an ordered
+    /// traversal stop at the first pruned smallest key.
     fn keep(&self, key: f64) -> bool;
     /// Whether a dive of an ordered traversal continues into a child with this key: by
     /// default when it is kept. A distance query with an error allowance dives while the
@@ -55,7 +58,7 @@ pub(crate) trait Policy<B: BoundingVolume> {
     ) -> Flow;
 }
 
-/// A node pair waiting on the stack, with the key computed when it was pushed.
+/// A node pair waiting, with the key computed when it was pushed (ordered policies).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Pending {
     a: u32,
