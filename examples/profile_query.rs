@@ -71,6 +71,19 @@ fn main() {
             }
         }
     };
+    if kind == "views" {
+        // The cost of typing a file's sections, which every query of a PairQuery pays.
+        let t0 = Instant::now();
+        for _ in 0..runs {
+            let f = std::hint::black_box(&a);
+            std::hint::black_box(f.view::<obbtree::bv::Obb<f32>>().expect("view"));
+        }
+        println!(
+            "view: {:.1} ns",
+            t0.elapsed().as_secs_f64() * 1e9 / runs as f64
+        );
+        return;
+    }
     println!("{kind} at x = {x}: {:?}", once(&mut pair));
     // The median of 11 batches: the machine is shared, and a batch may be interrupted.
     let mut batches: Vec<f64> = (0..11)

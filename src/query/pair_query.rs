@@ -1,9 +1,9 @@
 //! Two trees queried together many times, with the poses per call.
 
 use super::{
-    collide_into, distance, distance_below, span, with_views, within_tolerance, CollideOptions,
+    collide_into, distance, distance_below, on_views, span, within_tolerance, CollideOptions,
     CollideResult, DescentRule, DistanceOptions, DistanceResult, Pose, QueryContext, QueryError,
-    SpanResult, Stats, ToleranceResult,
+    SpanResult, Stats, ToleranceResult, ViewPair,
 };
 use crate::format::ObbtFile;
 
@@ -36,6 +36,8 @@ use crate::format::ObbtFile;
 pub struct PairQuery<'f> {
     a: &'f ObbtFile,
     b: &'f ObbtFile,
+    /// The typed views of A and B, made once (each query would otherwise make them again).
+    views: ViewPair<'f>,
     context: QueryContext,
     /// The pair buffer of first-contact queries, kept so that a yes/no query per frame
     /// allocates nothing.
@@ -45,12 +47,13 @@ pub struct PairQuery<'f> {
 impl<'f> PairQuery<'f> {
     /// The pair (A, B); an error if they store different volume types or precisions.
     pub fn new(a: &'f ObbtFile, b: &'f ObbtFile) -> Result<PairQuery<'f>, QueryError> {
-        with_views!(a, b, |_va, _vb| Ok(PairQuery {
+        Ok(PairQuery {
             a,
             b,
+            views: ViewPair::of(a, b)?,
             context: QueryContext::new(),
             first: CollideResult::default(),
-        }))
+        })
     }
 
     /// Model A.
@@ -84,7 +87,7 @@ impl<'f> PairQuery<'f> {
         result: &mut CollideResult,
     ) -> Result<(), QueryError> {
         let context = &mut self.context;
-        with_views!(self.a, self.b, |va, vb| collide_into(
+        on_views!(self.views, |va, vb| collide_into(
             &va, pose_a, &vb, pose_b, options, context, result
         ))
     }
@@ -124,7 +127,7 @@ impl<'f> PairQuery<'f> {
         options: &DistanceOptions,
     ) -> Result<DistanceResult, QueryError> {
         let context = &mut self.context;
-        with_views!(self.a, self.b, |va, vb| distance(
+        on_views!(self.views, |va, vb| distance(
             &va, pose_a, &vb, pose_b, options, context
         ))
     }
@@ -138,7 +141,7 @@ impl<'f> PairQuery<'f> {
         limit: f64,
     ) -> Result<(Option<DistanceResult>, Stats), QueryError> {
         let context = &mut self.context;
-        with_views!(self.a, self.b, |va, vb| distance_below(
+        on_views!(self.views, |va, vb| distance_below(
             &va, pose_a, &vb, pose_b, options, limit, context
         ))
     }
@@ -152,7 +155,7 @@ impl<'f> PairQuery<'f> {
         rule: DescentRule,
     ) -> Result<ToleranceResult, QueryError> {
         let context = &mut self.context;
-        with_views!(self.a, self.b, |va, vb| within_tolerance(
+        on_views!(self.views, |va, vb| within_tolerance(
             &va, pose_a, &vb, pose_b, tolerance, rule, context
         ))
     }
@@ -165,7 +168,7 @@ impl<'f> PairQuery<'f> {
         rule: DescentRule,
     ) -> Result<SpanResult, QueryError> {
         let context = &mut self.context;
-        with_views!(self.a, self.b, |va, vb| span(
+        on_views!(self.views, |va, vb| span(
             &va, pose_a, &vb, pose_b, rule, context
         ))
     }
