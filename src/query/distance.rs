@@ -190,10 +190,12 @@ impl<B: BoundingVolume> Policy<B> for Distance {
 
     #[inline]
     fn dive_into(&self, key: f64) -> bool {
-        // Without the error allowances: with them, a dive would end above the best
-        // answer's allowance and never find the closer pair that lets everything else
-        // be pruned.
-        self.may_improve(key, 0.0, 0.0)
+        // With half the error allowances: with all of them, a dive would end above the
+        // best answer's allowance and never find the closer pair that lets everything
+        // else be pruned; with none, it would chase improvements the answer does not need
+        // (30 cow poses, rel_err 0.01: 23,868 pairs without, 20,976 with half; the old
+        // depth-first order 32,195). A child refused here is refused by `keep` too.
+        self.may_improve(key, 0.5 * self.rel_err, 0.5 * self.abs_err)
     }
 
     #[inline]

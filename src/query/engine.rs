@@ -38,10 +38,11 @@ pub(crate) trait Policy<B: BoundingVolume> {
     /// traversal stop at the first pruned smallest key.
     fn keep(&self, key: f64) -> bool;
     /// Whether a dive of an ordered traversal continues into a child with this key: by
-    /// default when it is kept. A distance query with an error allowance dives while the
-    /// child could still be closer than the best answer, and applies the allowance only to
-    /// the pairs it takes off the heap: so it looks for a better answer wherever a dive
-    /// is cheap, and stops once the allowance covers everything waiting.
+    /// default when it is kept. Must hold wherever `keep` does (a refused child is
+    /// dropped). A distance query with an error allowance dives with half of it and
+    /// applies all of it to the pairs it takes off the heap: so it looks for a better
+    /// answer wherever a dive is cheap, and stops once the allowance covers everything
+    /// waiting.
     #[inline]
     fn dive_into(&self, key: f64) -> bool {
         self.keep(key)
