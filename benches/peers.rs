@@ -126,7 +126,6 @@ struct Ours {
     first_s: f64,
     exact_s: f64,
     rel_s: f64,
-    box_tests: u64,
     tri_tests: u64,
 }
 
@@ -164,7 +163,6 @@ fn measure(pair: &mut PairQuery<'_>, pa: &Pose, pb: &Pose) -> Ours {
         first_s,
         exact_s,
         rel_s,
-        box_tests: d.stats.bv_overlap + d.stats.bv_disjoint,
         tri_tests: d.stats.tri_contact + d.stats.tri_separated,
     }
 }
@@ -328,7 +326,6 @@ fn run_case(case: &Case, peers: &Path, scratch: &Path, ratios: &mut Ratios) {
             fcl_c,
             fcl_d,
         );
-        let _ = ours.box_tests;
     }
 }
 

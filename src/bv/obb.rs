@@ -66,8 +66,11 @@ impl<R: Real> Obb<R> {
         );
         let offset = xf.apply(&cb) - ca;
         let (axes_a, axes_b) = (self.axes_matrix(), other.axes_matrix());
-        let frame_term = 4.0 * tol * offset.abs().sum();
-        if setup == PairSetup::Metric && frame_term > FAR * SAT_GUARD * (ha.sum() + hb.sum()) {
+        // (Overlap tests never re-orthonormalise: the frame term is only worked out for
+        // distance bounds.)
+        if setup == PairSetup::Metric
+            && 4.0 * tol * offset.abs().sum() > FAR * SAT_GUARD * (ha.sum() + hb.sum())
+        {
             return BoxPair::from_offset(
                 &orthonormal_rows(&axes_a),
                 widen(ha, tol),

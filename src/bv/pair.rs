@@ -215,25 +215,24 @@ impl BoxPair {
         if best >= enough {
             return best;
         }
-        let (gap, apart) = self.closest_direction_gap_and_apart();
+        let (gap, apart) = self.closest_direction_gap();
         best = best.max(gap - slack);
         // `apart` is the distance of a pair of points of the boxes, at least the box
         // distance: a gap near it is near the distance, and the edge axes can add little.
         if best >= enough || gap >= CONVERGED * apart {
             return best;
         }
-        best.max(self.edge_axis_gap(slack))
+        best.max(self.edge_axis_gap(&abs, slack))
     }
 
     /// The largest gap between the boxes' projections on the 9 edge-edge axes `a_i × b_j`,
-    /// each divided by the axis length, less `slack`; axes shorter than 1e-6 (nearly
+    /// each divided by the axis length, less `slack` (`abs` holds the `|m_ij|`); axes shorter than 1e-6 (nearly
     /// parallel edges, whose direction rounding makes meaningless) are skipped.
     #[inline]
     // why: as in `disjoint`, entries indexed by axis numbers in 0..3.
     #[allow(clippy::indexing_slicing)]
-    fn edge_axis_gap(&self, slack: f64) -> f64 {
+    fn edge_axis_gap(&self, abs: &Matrix3<f64>, slack: f64) -> f64 {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
-        let abs = m.abs();
         let mut best = 0.0f64;
         for i in 0..3 {
             let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
@@ -265,15 +264,11 @@ impl BoxPair {
     /// of it by a factor up to √3 (boxes diagonal to each other, about their size apart:
     /// most of the pairs a distance query opens). 0 if the points meet, which happens
     /// only when the boxes intersect (each point lies in its box).
+    ///
+    /// Returns the gap and the distance between the two points (a point of each box, so
+    /// at least the box distance: a gap near it is near the box distance).
     #[inline]
-    pub fn closest_direction_gap(&self) -> f64 {
-        self.closest_direction_gap_and_apart().0
-    }
-
-    /// [`BoxPair::closest_direction_gap`], and the distance between the two points whose
-    /// direction it uses: a point of each box, so at least the box distance.
-    #[inline]
-    fn closest_direction_gap_and_apart(&self) -> (f64, f64) {
+    pub fn closest_direction_gap(&self) -> (f64, f64) {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let mut p = clamp_box(t, a);
         let mut q = t + m * clamp_box(&m.tr_mul(&(p - t)), b);
