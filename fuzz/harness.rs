@@ -14,7 +14,7 @@
 #[path = "../tests/common/seal.rs"]
 mod seal;
 
-use obbtree::build::{build, BuildError, BuildOptions};
+use obbtree::build::{build, BuildError, BuildOptions, DEFAULT_HULL_MIN_FACES};
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile};
@@ -92,8 +92,14 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         leaf_size: [1, 2, 4, 128][(pick / 18) % 4],
         scale: [1.0, 1e-3, 1e3][(pick / 72) % 3],
         center: (pick / 216) % 2 == 1,
+        hull_min_faces: [2, DEFAULT_HULL_MIN_FACES][(pick / 432) % 2],
     };
-    for options in [BuildOptions::default(), other] {
+    // Fuzzed meshes are small: with the default threshold the hull fit would never run.
+    let hull_everywhere = BuildOptions {
+        hull_min_faces: 1,
+        ..BuildOptions::default()
+    };
+    for options in [hull_everywhere, other] {
         match build(mesh, &options, None) {
             Ok(file) => {
                 if let Err(error) = file.verify() {

@@ -5,6 +5,7 @@ mod common;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
+use obbtree::fit::FitMethod;
 use obbtree::format::{ObbtFile, TreeVisitor};
 use obbtree::mesh::TriMesh;
 use obbtree::real::{point_to_f64, Real};
@@ -263,4 +264,30 @@ fn coordinates_beyond_f32_are_a_build_error_for_f32_files() {
         .expect("f64 holds it")
         .verify()
         .expect("verifies");
+}
+
+/// The hull fit's size threshold: below it a node is fitted exactly as the triangle fit
+/// fits it, so a threshold above the mesh gives the triangle fit's tree, and the default
+/// gives a tree unlike both (its large nodes still fitted to their hulls).
+#[test]
+fn hull_fit_below_its_threshold_is_the_triangle_fit() {
+    let cow = common::cow();
+    let nodes = |options: BuildOptions| -> Vec<Obb<f32>> {
+        let file = build(&cow, &options, None).expect("builds");
+        let tree = file.view::<Obb<f32>>().expect("OBB f32");
+        tree.nodes().iter().map(|n| n.bv).collect()
+    };
+    let with = |fit, hull_min_faces| BuildOptions {
+        fit,
+        hull_min_faces,
+        ..BuildOptions::default()
+    };
+    let triangles = nodes(with(FitMethod::Triangles, 1));
+    assert_eq!(nodes(with(FitMethod::Hull, u32::MAX)), triangles);
+    let default = nodes(BuildOptions::default());
+    let everywhere = nodes(with(FitMethod::Hull, 1));
+    assert_ne!(default, triangles);
+    assert_ne!(default, everywhere);
+    // The hull fits the root in both.
+    assert_eq!(default.first(), everywhere.first());
 }

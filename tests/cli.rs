@@ -906,3 +906,50 @@ fn bad_scales_are_exit_1_naming_the_flag() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn build_help_states_the_library_defaults() {
+    let o = obbtree(&["build", "--help"]);
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout).replace('\n', " ");
+    let defaults = obbtree::build::BuildOptions::default();
+    for (flag, value) in [
+        ("--hull-min-faces", defaults.hull_min_faces.to_string()),
+        ("--leaf-size", defaults.leaf_size.to_string()),
+    ] {
+        let at = help
+            .find(flag)
+            .unwrap_or_else(|| panic!("{flag} in the help"));
+        let rest = &help[at..];
+        let end = rest.find("[default: ").expect("a stated default");
+        assert!(
+            rest[end..].starts_with(&format!("[default: {value}]")),
+            "{flag}: {}",
+            &rest[end..end + 20]
+        );
+    }
+}
+
+#[test]
+fn hull_min_faces_changes_the_tree_and_one_fits_every_node_to_its_hull() {
+    let dir = scratch("hull_min");
+    let (default, everywhere, five) = (
+        dir.join("default.obbt"),
+        dir.join("everywhere.obbt"),
+        dir.join("five.obbt"),
+    );
+    build(&default, &[]);
+    build(&everywhere, &["--hull-min-faces", "1"]);
+    build(&five, &["--hull-min-faces", "5"]);
+    let bytes = |p: &Path| std::fs::read(p).unwrap();
+    assert_ne!(bytes(&default), bytes(&everywhere));
+    assert_ne!(
+        bytes(&five),
+        bytes(&everywhere),
+        "nodes of 2 to 4 faces differ"
+    );
+    for p in [&default, &everywhere, &five] {
+        let o = obbtree(&["verify", p.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+}

@@ -32,6 +32,11 @@ pub struct BuildOptions {
     pub precision: Precision,
     /// The covariance the node frames are fitted to.
     pub fit: FitMethod,
+    /// With [`FitMethod::Hull`], the fewest faces a node needs for its frame to be fitted to
+    /// its convex hull; nodes with fewer are fitted to their triangles
+    /// ([`FitMethod::Triangles`]). Default [`DEFAULT_HULL_MIN_FACES`]; 1 fits every node to
+    /// its hull, as §3.4 describes. Ignored by the other methods.
+    pub hull_min_faces: u32,
     /// Largest number of triangles in a leaf, 1 to 128. With 1 the tree is binary with
     /// single-face leaves and uses the compact binary encoding.
     pub leaf_size: u32,
@@ -50,6 +55,7 @@ impl Default for BuildOptions {
             bv: BvKind::Obb,
             precision: Precision::F32,
             fit: FitMethod::Hull,
+            hull_min_faces: DEFAULT_HULL_MIN_FACES,
             leaf_size: 1,
             scale: 1.0,
             center: false,
@@ -57,7 +63,28 @@ impl Default for BuildOptions {
     }
 }
 
+/// The default [`BuildOptions::hull_min_faces`]. The hull fit earns its cost on large nodes,
+/// whose triangles sample the shape unevenly or hide detail inside it (§3.4); on a small
+/// patch of surface its hull adds phantom faces across every concavity, and the triangles'
+/// own covariance gives boxes as tight or tighter. Measured on the bunny, fandisk, pig, cow
+/// and a 40k lat/long sphere against a turned copy (40 poses each): at 512 every mesh's
+/// trees made 0.8 to 6.8% fewer box tests in all-pairs collision than with the hull at every
+/// node, and distance queries visited up to 11% fewer node pairs (the sphere 1% more),
+/// while a one-thread build took 35 to 40% less time.
+pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
+
 impl BuildOptions {
+    /// The fit of a node of `faces` faces: [`BuildOptions::fit`], except that a
+    /// [`FitMethod::Hull`] build fits nodes below [`BuildOptions::hull_min_faces`] to their
+    /// triangles.
+    pub fn fit_for(&self, faces: usize) -> FitMethod {
+        if self.fit == FitMethod::Hull && faces < self.hull_min_faces as usize {
+            FitMethod::Triangles
+        } else {
+            self.fit
+        }
+    }
+
     /// The checks of the options alone, before any mesh is read: `leaf_size` in 1..=128 and
     /// a finite `scale` greater than 0. [`build`] runs them too.
     pub fn validate(&self) -> Result<(), BuildError> {

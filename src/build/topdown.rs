@@ -243,7 +243,7 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
             || {
                 input_faces
                     .par_iter()
-                    .map(|f| leaf_volume::<B>(options.fit, positions, f))
+                    .map(|f| leaf_volume::<B>(options.fit_for(1), positions, f))
                     .collect::<Vec<B>>()
             },
         );
@@ -298,8 +298,8 @@ fn fit_and_split<B: BoundingVolume>(
         }
         return (B::new_zeroed(), None);
     }
-    let axes =
-        principal_axes_and_vertices(ctx.options.fit, ctx.positions, faces, &mut scratch.vertices);
+    let fit = ctx.options.fit_for(faces.len());
+    let axes = principal_axes_and_vertices(fit, ctx.positions, faces, &mut scratch.vertices);
     let bv = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
     if faces.len() <= ctx.options.leaf_size as usize {
         if let Some(p) = ctx.progress {

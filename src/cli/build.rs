@@ -78,6 +78,11 @@ pub struct TreeArgs {
     /// triangles (area-weighted), or the vertices [default: hull].
     #[arg(long, value_enum)]
     pub fit: Option<FitArg>,
+    /// With --fit hull, the fewest triangles a node needs to be fitted to its convex hull;
+    /// smaller nodes are fitted to their triangles, which is as tight there and much
+    /// cheaper. 1 fits every node to its hull [default: 512].
+    #[arg(long, value_name = "N")]
+    pub hull_min_faces: Option<u32>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
     /// [default: 1].
     #[arg(long, value_name = "N")]
@@ -138,6 +143,7 @@ impl TreeArgs {
                 PrecisionArg::F32 => Precision::F32,
                 PrecisionArg::F64 => Precision::F64,
             }),
+            hull_min_faces: self.hull_min_faces.unwrap_or(default.hull_min_faces),
             leaf_size: self.leaf_size.unwrap_or(default.leaf_size),
             ..default
         }
@@ -148,6 +154,7 @@ impl TreeArgs {
         [
             ("--bv", self.bv.is_some()),
             ("--fit", self.fit.is_some()),
+            ("--hull-min-faces", self.hull_min_faces.is_some()),
             ("--leaf-size", self.leaf_size.is_some()),
             ("--precision", self.precision.is_some()),
         ]
