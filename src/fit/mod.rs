@@ -11,6 +11,13 @@
 //! eigen-decomposition, ties), `frame` (deterministic completion, signs, handedness),
 //! `symmetry` (axes inside tied eigenspaces), `principal` (the pipeline).
 
+// why: fit/ indexes only its own buffers (scratch points, hull faces, horizon edges),
+// in bounds by the invariants it establishes itself; a broken one is a bug that must fail
+// loudly (a panic in tests and fuzzing), not turn into a silent fallback frame. Indices
+// that come from a mesh are checked where they enter (`Scratch::gather`, the one-face
+// case below), so untrusted data still never panics here.
+#![allow(clippy::indexing_slicing)]
+
 use std::cell::RefCell;
 
 use nalgebra::Matrix3;

@@ -144,14 +144,14 @@ impl QuickHull {
                 continue;
             }
             for f in 0..4u32 {
-                if let Some(d) = self.faces.get(f as usize).and_then(|x| x.outside(p)) {
+                if let Some(d) = self.faces[f as usize].outside(p) {
                     self.push_outside(f, i as u32, d);
                     break;
                 }
             }
         }
         for f in 0..4u32 {
-            if self.faces.get(f as usize).is_some_and(|x| x.head != NONE) {
+            if self.faces[f as usize].head != NONE {
                 self.pending.push(f);
             }
         }
@@ -160,9 +160,7 @@ impl QuickHull {
         // again, so at most `n` iterations happen; the bound is a second guard.
         let mut budget = n;
         while let Some(f) = self.pending.pop() {
-            let Some(face) = self.faces.get(f as usize) else {
-                return Err(QuickHullError::Numerical);
-            };
+            let face = &self.faces[f as usize];
             if !face.alive || face.head == NONE {
                 continue;
             }
@@ -181,28 +179,21 @@ impl QuickHull {
     /// Builds the four faces of the seed tetrahedron, oriented outwards, with adjacency.
     fn seed(&mut self, points: &[V3], s: [usize; 4], eps: f64) -> Result<(), QuickHullError> {
         for (k, (v, adj)) in seed_faces(points, s)?.into_iter().enumerate() {
+            // The faces were cleared, so the seed's faces are 0 to 3, in order.
             let f = self.new_face(points, v, eps)?;
-            let face = self
-                .faces
-                .get_mut(f as usize)
-                .ok_or(QuickHullError::Input)?;
-            if f as usize != k {
-                return Err(QuickHullError::Input);
-            }
-            face.adj = adj;
+            debug_assert_eq!(f as usize, k);
+            self.faces[f as usize].adj = adj;
         }
         Ok(())
     }
 
     /// Allocates a face (reusing a freed slot) with its plane; no adjacency, no points.
     fn new_face(&mut self, points: &[V3], v: [u32; 3], eps: f64) -> Result<u32, QuickHullError> {
-        let p = |i: u32| {
-            points
-                .get(i as usize)
-                .copied()
-                .ok_or(QuickHullError::Numerical)
-        };
-        let (a, b, c) = (p(v[0])?, p(v[1])?, p(v[2])?);
+        let (a, b, c) = (
+            points[v[0] as usize],
+            points[v[1] as usize],
+            points[v[2] as usize],
+        );
         let normal = cross(sub(b, a), sub(c, a));
         let len2 = norm2(normal);
         if !(len2 > 0.0 && len2.is_finite()) {
@@ -224,10 +215,8 @@ impl QuickHull {
             alive: true,
         };
         if let Some(slot) = self.free.pop() {
-            if let Some(f) = self.faces.get_mut(slot as usize) {
-                *f = face;
-                return Ok(slot);
-            }
+            self.faces[slot as usize] = face;
+            return Ok(slot);
         }
         if self.faces.len() >= NONE as usize - 1 {
             return Err(QuickHullError::Numerical);
@@ -239,16 +228,12 @@ impl QuickHull {
     /// Adds point `p` at height `d` to the outside list of face `f`.
     #[inline]
     fn push_outside(&mut self, f: u32, p: u32, d: f64) {
-        if let (Some(face), Some(link)) = (
-            self.faces.get_mut(f as usize),
-            self.next.get_mut(p as usize),
-        ) {
-            *link = face.head;
-            face.head = p;
-            if face.far == NONE || d > face.far_dist {
-                face.far = p;
-                face.far_dist = d;
-            }
+        let face = &mut self.faces[f as usize];
+        self.next[p as usize] = face.head;
+        face.head = p;
+        if face.far == NONE || d > face.far_dist {
+            face.far = p;
+            face.far_dist = d;
         }
     }
 
@@ -260,10 +245,7 @@ impl QuickHull {
         apex: u32,
         eps: f64,
     ) -> Result<(), QuickHullError> {
-        let apex_p = points
-            .get(apex as usize)
-            .copied()
-            .ok_or(QuickHullError::Numerical)?;
+        let apex_p = points[apex as usize];
         self.iteration = self.iteration.wrapping_add(1);
         let it = self.iteration;
         self.find_visible(apex_p, start, it)?;
@@ -301,7 +283,7 @@ impl QuickHull {
         // that edge k ends where edge k + 1 starts.
         self.new_faces.clear();
         for k in 0..self.horizon.len() {
-            let Some(&e) = self.horizon.get(k) else { break };
+            let e = self.horizon[k];
             let f = self.new_face(points, [e.a, e.b, apex], eps)?;
             self.new_faces.push(f);
         }
@@ -318,64 +300,38 @@ impl QuickHull {
         for k in 0..h {
             // Neighbours in the cone, without `%` (an integer division per edge).
             let next = if k + 1 < h { k + 1 } else { 0 };
-            // `new_faces` and `horizon` both have `h` entries, so these always succeed.
-            let (Some(&f), Some(&e), Some(&next_f), Some(next_e)) = (
-                self.new_faces.get(k),
-                self.horizon.get(k),
-                self.new_faces.get(next),
-                self.horizon.get(next),
-            ) else {
-                return Err(QuickHullError::Numerical);
-            };
-            let next_b = next_e.b;
-            let (Some(across), Some(face), Some(following)) = (
-                self.faces.get(e.across as usize),
-                self.faces.get(f as usize),
-                self.faces.get(next_f as usize),
-            ) else {
-                return Err(QuickHullError::Numerical);
-            };
+            let (f, e) = (self.new_faces[k], self.horizon[k]);
+            let (next_f, next_b) = (self.new_faces[next], self.horizon[next].b);
+            let (across, face, following) = (
+                &self.faces[e.across as usize],
+                &self.faces[f as usize],
+                &self.faces[next_f as usize],
+            );
+            // A horizon edge whose hidden face lacks it means broken adjacency.
             let (j, far) = find_edge(&across.v, e.b, e.a).ok_or(QuickHullError::Numerical)?;
-            let (Some(&w), Some(&c)) = (points.get(far as usize), points.get(next_b as usize))
-            else {
-                return Err(QuickHullError::Numerical);
-            };
+            let (w, c) = (points[far as usize], points[next_b as usize]);
             if broken_edge(face, across.normal, w, limit, flat)
                 || broken_edge(face, following.normal, c, limit, flat)
             {
                 return Err(QuickHullError::Numerical);
             }
-            if let Some(adj) = self
-                .faces
-                .get_mut(e.across as usize)
-                .and_then(|across| across.adj.get_mut(j))
-            {
-                *adj = f;
-            }
-            if let Some(face) = self.faces.get_mut(f as usize) {
-                face.adj = [e.across, next_f, prev_f];
-            }
+            self.faces[e.across as usize].adj[j] = f;
+            self.faces[f as usize].adj = [e.across, next_f, prev_f];
             prev_f = f;
         }
 
         // Hand the outside points of the doomed faces to the new ones.
         for vi in 0..self.visible.len() {
-            let Some(&g) = self.visible.get(vi) else {
-                break;
-            };
-            let mut p = self.faces.get(g as usize).map_or(NONE, |x| x.head);
+            let mut p = self.faces[self.visible[vi] as usize].head;
             while p != NONE {
-                let following = self.next.get(p as usize).copied().unwrap_or(NONE);
+                let following = self.next[p as usize];
                 if p != apex {
-                    if let Some(&q) = points.get(p as usize) {
-                        for k in 0..h {
-                            let Some(&f) = self.new_faces.get(k) else {
-                                break;
-                            };
-                            if let Some(d) = self.faces.get(f as usize).and_then(|x| x.outside(q)) {
-                                self.push_outside(f, p, d);
-                                break;
-                            }
+                    let q = points[p as usize];
+                    for k in 0..h {
+                        let f = self.new_faces[k];
+                        if let Some(d) = self.faces[f as usize].outside(q) {
+                            self.push_outside(f, p, d);
+                            break;
                         }
                     }
                 }
@@ -383,14 +339,13 @@ impl QuickHull {
             }
         }
         for &g in &self.visible {
-            if let Some(face) = self.faces.get_mut(g as usize) {
-                face.alive = false;
-                face.head = NONE;
-                self.free.push(g);
-            }
+            let face = &mut self.faces[g as usize];
+            face.alive = false;
+            face.head = NONE;
+            self.free.push(g);
         }
         for &f in &self.new_faces {
-            if self.faces.get(f as usize).is_some_and(|x| x.head != NONE) {
+            if self.faces[f as usize].head != NONE {
                 self.pending.push(f);
             }
         }
@@ -404,25 +359,16 @@ impl QuickHull {
         self.horizon.clear();
         self.stack.clear();
         self.suspicious = false;
-        let first = self
-            .faces
-            .get_mut(start as usize)
-            .ok_or(QuickHullError::Numerical)?;
+        let first = &mut self.faces[start as usize];
         first.mark = it;
         first.visible = true;
         self.stack.push(start);
         while let Some(g) = self.stack.pop() {
             self.visible.push(g);
-            let (v, adj) = self
-                .faces
-                .get(g as usize)
-                .map(|x| (x.v, x.adj))
-                .ok_or(QuickHullError::Numerical)?;
+            let Face { v, adj, .. } = self.faces[g as usize];
             for (a, b, h) in edges(v, adj) {
-                let hf = self
-                    .faces
-                    .get_mut(h as usize)
-                    .ok_or(QuickHullError::Numerical)?;
+                let hf = &mut self.faces[h as usize];
+                // A dead face still linked: the repairs broke the adjacency.
                 if !hf.alive {
                     return Err(QuickHullError::Numerical);
                 }
@@ -461,18 +407,13 @@ impl QuickHull {
         }
         let stamp = self.chain;
         for (k, e) in self.horizon.iter().enumerate() {
-            let (Some(mark), Some(slot)) = (
-                self.slot_mark.get_mut(e.a as usize),
-                self.slot.get_mut(e.a as usize),
-            ) else {
-                return false;
-            };
-            if *mark == stamp {
+            let a = e.a as usize;
+            if self.slot_mark[a] == stamp {
                 // Two horizon edges leave the same vertex: the loop is pinched.
                 return false;
             }
-            *mark = stamp;
-            *slot = k as u32;
+            self.slot_mark[a] = stamp;
+            self.slot[a] = k as u32;
         }
         // Walk the loop from edge 0. Returning to edge 0 first after exactly h steps
         // means every edge was visited once: the horizon is a single closed loop.
@@ -482,15 +423,14 @@ impl QuickHull {
             if step > 0 && k == 0 {
                 return false;
             }
-            let Some(&e) = self.horizon.get(k) else {
-                return false;
-            };
+            let e = self.horizon[k];
             self.ordered.push(e);
             let b = e.b as usize;
-            if self.slot_mark.get(b).copied() != Some(stamp) {
+            if self.slot_mark[b] != stamp {
+                // No horizon edge leaves where this one ends: the loop is open.
                 return false;
             }
-            k = self.slot.get(b).copied().unwrap_or(NONE) as usize;
+            k = self.slot[b] as usize;
         }
         if k != 0 {
             return false;
@@ -505,12 +445,8 @@ impl QuickHull {
     fn absorb_coplanar(&mut self, apex: V3, it: u32, margin: f64) -> bool {
         let mut grown = false;
         for k in 0..self.horizon.len() {
-            let Some(h) = self.horizon.get(k).map(|e| e.across) else {
-                return false;
-            };
-            let Some(face) = self.faces.get_mut(h as usize) else {
-                return false;
-            };
+            let h = self.horizon[k].across;
+            let face = &mut self.faces[h as usize];
             // Faces first reached by an earlier repair round have not been examined yet.
             if face.mark != it || !face.visible {
                 face.mark = it;
@@ -521,7 +457,10 @@ impl QuickHull {
                 }
             }
         }
-        grown && self.rebuild_horizon(it)
+        if grown {
+            self.rebuild_horizon(it);
+        }
+        grown
     }
 
     /// Adds to the visible region the hidden faces across the horizon that the apex is
@@ -531,15 +470,9 @@ impl QuickHull {
     fn absorb_folds(&mut self, points: &[V3], apex: V3, it: u32) -> bool {
         let mut grown = false;
         for k in 0..self.horizon.len() {
-            let Some(&e) = self.horizon.get(k) else {
-                return false;
-            };
-            let (Some(&a), Some(&b)) = (points.get(e.a as usize), points.get(e.b as usize)) else {
-                return false;
-            };
-            let Some(face) = self.faces.get_mut(e.across as usize) else {
-                return false;
-            };
+            let e = self.horizon[k];
+            let (a, b) = (points[e.a as usize], points[e.b as usize]);
+            let face = &mut self.faces[e.across as usize];
             if face.mark == it && face.visible {
                 continue; // absorbed through an earlier edge of this round
             }
@@ -554,27 +487,24 @@ impl QuickHull {
                 grown = true;
             }
         }
-        grown && self.rebuild_horizon(it)
+        if grown {
+            self.rebuild_horizon(it);
+        }
+        grown
     }
 
-    /// Recomputes the (unordered) horizon of the visible faces; false on broken adjacency.
-    fn rebuild_horizon(&mut self, it: u32) -> bool {
+    /// Recomputes the (unordered) horizon of the visible faces.
+    fn rebuild_horizon(&mut self, it: u32) {
         self.horizon.clear();
         for &g in &self.visible {
-            let Some(&Face { v, adj, .. }) = self.faces.get(g as usize) else {
-                return false;
-            };
+            let Face { v, adj, .. } = self.faces[g as usize];
             for (a, b, across) in edges(v, adj) {
-                let visible = self
-                    .faces
-                    .get(across as usize)
-                    .is_some_and(|x| x.mark == it && x.visible);
-                if !visible {
+                let x = &self.faces[across as usize];
+                if !(x.mark == it && x.visible) {
                     self.horizon.push(Edge { a, b, across });
                 }
             }
         }
-        true
     }
 }
 
