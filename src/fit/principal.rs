@@ -104,10 +104,8 @@ fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Frame, Source)> {
         let poly = &s.hull.poly;
         let plane = &s.hull.plane;
         let at = |i: u32| {
-            plane
-                .get(i as usize)
-                .map(|q| [q[0], q[1], 0.0])
-                .unwrap_or([0.0; 3])
+            let q = plane[i as usize];
+            [q[0], q[1], 0.0]
         };
         let (&first, rest) = poly.split_first()?;
         let mut m = Moments::default();
@@ -126,12 +124,7 @@ fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Frame, Source)> {
         let pts = &s.pts;
         let mut m = Moments::default();
         for t in &s.hull.tris {
-            let (p, q, r) = (
-                pts.get(t[0] as usize)?,
-                pts.get(t[1] as usize)?,
-                pts.get(t[2] as usize)?,
-            );
-            m.add_triangle(*p, *q, *r);
+            m.add_triangle(pts[t[0] as usize], pts[t[1] as usize], pts[t[2] as usize]);
         }
         let c = m.covariance()?;
         Some((axes3(&c)?, Source::HullSolid))
@@ -182,22 +175,18 @@ fn largest_triangles(
     faces: &[[u32; 3]],
 ) -> LargestTriangles {
     let mut best = LargestTriangles::default();
-    let pt = |i: u32| -> Option<V3> { s.pts.get(i as usize).copied() };
+    let pt = |i: u32| -> V3 { s.pts[i as usize] };
     match source {
         Source::HullSolid => {
             for t in &s.hull.tris {
-                if let (Some(p), Some(q), Some(r)) = (pt(t[0]), pt(t[1]), pt(t[2])) {
-                    best.offer(p, q, r);
-                }
+                best.offer(pt(t[0]), pt(t[1]), pt(t[2]));
             }
         }
         Source::HullFlat => {
             if let Some((&first, rest)) = s.hull.poly.split_first() {
                 for w in rest.windows(2) {
                     let &[a, b] = w else { continue };
-                    if let (Some(p), Some(q), Some(r)) = (pt(first), pt(a), pt(b)) {
-                        best.offer(p, q, r);
-                    }
+                    best.offer(pt(first), pt(a), pt(b));
                 }
             }
         }
