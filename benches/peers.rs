@@ -80,6 +80,11 @@ fn pose_line(a: &Pose, b: &Pose) -> String {
 
 /// The JSON lines a peer prints for a case, or `None` when the peer is not built.
 fn run_peer(dir: &Path, peer: &str, case: &Path) -> Option<Vec<Value>> {
+    run_peer_with(dir, peer, case, &[])
+}
+
+/// [`run_peer`] with extra arguments (`--build-reps N`: only the median build times).
+fn run_peer_with(dir: &Path, peer: &str, case: &Path, extra: &[&str]) -> Option<Vec<Value>> {
     let binary = dir.join(peer);
     if !binary.exists() {
         return None;
@@ -90,6 +95,7 @@ fn run_peer(dir: &Path, peer: &str, case: &Path) -> Option<Vec<Value>> {
         .arg(case.join("poses.txt"))
         .args(["--min-runs", &MIN_RUNS.to_string()])
         .args(["--min-time", &MIN_TIME.to_string()])
+        .args(extra)
         .output()
         .expect("runs the peer");
     assert!(
@@ -188,6 +194,9 @@ impl Ratios {
 }
 
 /// Seconds as milliseconds with 4 significant digits (culled queries take 0.0001 ms).
+/// Builds timed per case and thread count (the median is reported).
+const BUILD_REPS: usize = 5;
+
 fn ms(s: f64) -> String {
     if s >= 1e-3 {
         format!("{:.3}", s * 1e3)
@@ -212,12 +221,34 @@ fn run_case(case: &Case, peers: &Path, scratch: &Path, ratios: &mut Ratios) {
     let a = TriMesh::load(&dir.join("a.obj")).expect("mesh A");
     let b = TriMesh::load(&dir.join("b.obj")).expect("mesh B");
     let options = BuildOptions::default();
-    let t0 = Instant::now();
-    let (fa, fb): (ObbtFile, ObbtFile) = (
-        build(&a, &options, None).expect("build"),
-        build(&b, &options, None).expect("build"),
-    );
-    let build_s = t0.elapsed().as_secs_f64();
+    let build_both = || -> (ObbtFile, ObbtFile) {
+        (
+            build(&a, &options, None).expect("build"),
+            build(&b, &options, None).expect("build"),
+        )
+    };
+    // Median of BUILD_REPS builds of both models, with one thread and with two.
+    let timed_build = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool");
+        let mut times: Vec<f64> = (0..BUILD_REPS)
+            .map(|_| {
+                let t0 = Instant::now();
+                std::hint::black_box(pool.install(build_both));
+                t0.elapsed().as_secs_f64()
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times[times.len() / 2]
+    };
+    let (build_1, build_s) = (timed_build(1), timed_build(2));
+    let (fa, fb) = build_both();
+    let rapid_reps = run_peer_with(peers, "bench_rapid", &dir, &["--build-reps", "5"]);
+    let rapid_build_median = rapid_reps
+        .as_ref()
+        .and_then(|l| l.iter().find(|v| v["kind"] == "build_reps"));
     let bytes =
         (fa.bytes().len() + fb.bytes().len()) as f64 / (a.faces().len() + b.faces().len()) as f64;
     let rapid_build = rapid
@@ -227,14 +258,17 @@ fn run_case(case: &Case, peers: &Path, scratch: &Path, ratios: &mut Ratios) {
         .as_ref()
         .and_then(|l| l.iter().find(|v| v["kind"] == "build"));
     let peer_build = |v: Option<&Value>| Some(number(v, "build_a_s")? + number(v, "build_b_s")?);
+    let rapid_median = peer_build(rapid_build_median).or(peer_build(rapid_build));
     println!(
-        "\n## {} ({} + {} triangles): build {} ms (RAPID {} ms, ratio {}); {:.0} B/triangle (RAPID {}, PQP {})",
+        "\n## {} ({} + {} triangles): build {} ms with 1 thread, {} ms with 2 (RAPID {} ms, ratios {} and {}); {:.0} B/triangle (RAPID {}, PQP {})",
         case.name,
         a.faces().len(),
         b.faces().len(),
+        ms(build_1),
         ms(build_s),
-        peer_build(rapid_build).map_or("—".into(), ms),
-        ratios.add("build (2 threads) / RAPID", build_s, peer_build(rapid_build)),
+        rapid_median.map_or("—".into(), ms),
+        ratios.add("build (1 thread) / RAPID", build_1, rapid_median),
+        ratios.add("build (2 threads) / RAPID", build_s, rapid_median),
         bytes,
         number(rapid_build, "used_bytes_per_tri_a").map_or("—".into(), |v| format!("{v:.0}")),
         number(pqp_build, "bytes_per_tri_a").map_or("—".into(), |v| format!("{v:.0}")),
