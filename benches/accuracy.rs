@@ -140,7 +140,7 @@ fn bunny() -> Option<Scene> {
         });
     let center = Vector3::from(std::array::from_fn(|k| (lo[k] + hi[k]) / 2.0));
     let size = Vector3::from(std::array::from_fn(|k| hi[k] - lo[k]));
-    let r = common::seeded_rotation(11);
+    let r = common::rng::seeded_rotation(11);
     // Rotate the copy about the bunny's centre, then shift it along x.
     let around_center = |shift: f64| -> Pose {
         Pose::new(r, center - r * center + Vector3::new(shift, 0.0, 0.0)).expect("rotation")

@@ -391,8 +391,8 @@ fn posed_pairs(a: &TriMesh, b: &TriMesh, scales: &[f64], seed: u64) -> Vec<(Pose
     for (k, s) in scales.iter().enumerate() {
         for trial in 0..2u64 {
             let seed = seed * 100 + k as u64 * 10 + trial;
-            let r = common::seeded_rotation(seed);
-            let dir = common::seeded_rotation(seed + 7) * nalgebra::Vector3::x();
+            let r = common::rng::seeded_rotation(seed);
+            let dir = common::rng::seeded_rotation(seed + 7) * nalgebra::Vector3::x();
             // B's centre lands at A's centre plus the offset.
             let t = ca + dir * (s * d) - r * cb;
             poses.push((Pose::identity(), Pose::new(r, t).expect("rotation")));

@@ -122,7 +122,8 @@ fn concentric_spheres(c: &mut Criterion) {
     let outer = common::uv_sphere(1.05, 101, 200);
     let (ta, tb) = (tree(&inner), tree(&outer));
     let (pa, pb) = (parry_mesh(&inner), parry_mesh(&outer));
-    let pose = Pose::new(common::seeded_rotation(7), nalgebra::Vector3::zeros()).expect("rotation");
+    let pose =
+        Pose::new(common::rng::seeded_rotation(7), nalgebra::Vector3::zeros()).expect("rotation");
     let mut context = QueryContext::new();
     let exact = DistanceOptions::default();
     let r =
@@ -168,7 +169,8 @@ fn far_apart(c: &mut Criterion) {
         let file = obbtree::build::build(&cow, &options, None).expect("builds");
         for offset in [1e3, 1e5, 1e6, 1e9] {
             let direction = nalgebra::Vector3::new(1.0, -1.0, 1.0).normalize();
-            let pose = Pose::new(common::seeded_rotation(3), direction * offset).expect("pose");
+            let pose =
+                Pose::new(common::rng::seeded_rotation(3), direction * offset).expect("pose");
             let a = Pose::identity();
             let exact = DistanceOptions::default();
             let rel = DistanceOptions {

@@ -71,7 +71,7 @@ fn many_objects() -> (Scene, Scene, Vec<Vector3<f64>>) {
             random.next() * 14.0,
             random.next() * 2.0,
         );
-        let r = common::seeded_rotation(k as u64);
+        let r = common::rng::seeded_rotation(k as u64);
         let group = format!("g{}", k % 20);
         let asset = assets[k % assets.len()].clone();
         builder.object(

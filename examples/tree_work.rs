@@ -61,8 +61,8 @@ fn main() {
     let mut contacts = Default::default();
     let (mut collide_tests, mut first_nodes, mut distance_nodes, mut distance_tris) = (0, 0, 0, 0);
     for k in 0..40u64 {
-        let turn = common::seeded_rotation(k + 1);
-        let direction = common::seeded_rotation(k + 101) * Vector3::x();
+        let turn = common::rng::seeded_rotation(k + 1);
+        let direction = common::rng::seeded_rotation(k + 101) * Vector3::x();
         let near = [0.2, 0.35, 0.5, 0.65][(k % 4) as usize];
         let near = Pose::new(turn, direction * diagonal * near).expect("a rotation");
         pair.collide_into(&here, &near, &CollideOptions::default(), &mut contacts)

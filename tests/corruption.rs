@@ -67,14 +67,11 @@ fn sampled_byte_flips_of_a_larger_file_are_detected() {
     )
     .unwrap();
     let original = file.bytes().to_vec();
-    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut rng = common::rng::Rng::new(1);
     for _ in 0..300 {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        let i = (state % original.len() as u64) as usize;
+        let i = rng.below(original.len());
         let mut bytes = original.clone();
-        bytes[i] ^= 1 << (state >> 61);
+        bytes[i] ^= 1 << rng.below(8);
         assert_rejected(&bytes, &format!("byte {i}"));
     }
 }

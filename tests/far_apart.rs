@@ -28,7 +28,11 @@ fn triangle_tests(s: &Stats) -> u64 {
 /// B turned a little (so no box axis lines up with the offset) and moved `offset` along
 /// `direction`.
 fn pose_b(offset: f64, direction: Vector3<f64>) -> Pose {
-    Pose::new(common::seeded_rotation(3), direction.normalize() * offset).unwrap()
+    Pose::new(
+        common::rng::seeded_rotation(3),
+        direction.normalize() * offset,
+    )
+    .unwrap()
 }
 
 struct Work {

@@ -6,30 +6,13 @@ use obbtree::fit::hull::{convex_hull, ConvexHull, HULL_TOLERANCE};
 use obbtree::fit::{principal_axes, FitMethod};
 use proptest::prelude::*;
 
+mod common;
+
+use common::rng::Rng;
+
 type P = [f64; 3];
 
 // ---------------------------------------------------------------- helpers
-
-/// A small deterministic generator (SplitMix64) for seeded random inputs.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform in [-1, 1).
-    fn signed(&mut self) -> f64 {
-        2.0 * self.unit() - 1.0
-    }
-}
 
 fn col(m: &Matrix3<f64>, i: usize) -> Vector3<f64> {
     m.column(i).into_owned()
@@ -465,13 +448,13 @@ fn far_from_origin_box_is_still_exact() {
 
 #[test]
 fn duplicated_vertices_and_triangles_change_nothing_for_hull_and_vertices() {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let pos: Vec<P> = (0..40)
         .map(|_| [rng.signed() * 3.0, rng.signed(), rng.signed() * 0.5])
         .collect();
     let faces: Vec<[u32; 3]> = (0..30)
         .map(|_| {
-            let mut i = || (rng.next_u64() % 40) as u32;
+            let mut i = || rng.below(40) as u32;
             [i(), i(), i()]
         })
         .collect();
@@ -509,7 +492,7 @@ fn duplicated_vertices_and_triangles_change_nothing_for_hull_and_vertices() {
 
 #[test]
 fn results_are_deterministic_bitwise() {
-    let mut rng = Rng(11);
+    let mut rng = Rng::new(11);
     let pos: Vec<P> = (0..500)
         .map(|_| [rng.signed(), rng.signed() * 2.0, rng.signed()])
         .collect();
@@ -549,7 +532,7 @@ fn odd_input_never_panics() {
 
 #[test]
 fn hull_frame_matches_an_independent_computation() {
-    let mut rng = Rng(3);
+    let mut rng = Rng::new(3);
     // An anisotropic cloud so the axes are well separated.
     let pos: Vec<P> = (0..300)
         .map(|_| {
@@ -566,7 +549,7 @@ fn hull_frame_matches_an_independent_computation() {
 
 #[test]
 fn every_method_gives_a_frame_on_random_clouds() {
-    let mut rng = Rng(99);
+    let mut rng = Rng::new(99);
     for n in [3usize, 4, 5, 8, 17, 64, 1000] {
         let pos: Vec<P> = (0..n)
             .map(|_| [rng.signed(), rng.signed(), rng.signed()])
@@ -581,7 +564,7 @@ fn every_method_gives_a_frame_on_random_clouds() {
 
 #[test]
 fn hull_of_cube_corners_and_interior_points() {
-    let mut rng = Rng(5);
+    let mut rng = Rng::new(5);
     let (mut pos, _) = box_mesh([0.5, 0.5, 0.5], [0.5, 0.5, 0.5], &Matrix3::identity());
     pos.extend((0..200).map(|_| {
         [
@@ -621,7 +604,7 @@ fn hull_of_points_on_a_sphere_uses_every_point() {
 
 #[test]
 fn hull_of_random_points_contains_them() {
-    let mut rng = Rng(42);
+    let mut rng = Rng::new(42);
     for (n, scale) in [(10usize, 1.0), (100, 1e-3), (1000, 1.0), (5000, 1e4)] {
         let pos: Vec<P> = (0..n)
             .map(|_| {
@@ -699,10 +682,10 @@ fn hull_of_noisy_nearly_coplanar_points_succeeds() {
         (5, 1e-7),
         (6, 1e-5),
     ] {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let mut pos = Vec::new();
         for _ in 0..3000 {
-            let axis = (rng.next_u64() % 3) as usize;
+            let axis = rng.below(3);
             let mut q = [rng.signed() * 2.0, rng.signed(), rng.signed() * 0.5];
             q[axis] = if rng.unit() < 0.5 { -1.0 } else { 1.0 } * [2.0, 1.0, 0.5][axis];
             let p = rot * (v(q) + Vector3::new(rng.signed(), rng.signed(), rng.signed()) * noise);
@@ -828,10 +811,10 @@ proptest! {
 
     #[test]
     fn prop_frames_are_orthonormal_and_right_handed(pts in cloud(), seed in any::<u64>()) {
-        let n = pts.len() as u64;
-        let mut rng = Rng(seed);
-        let faces: Vec<[u32; 3]> = (0..1 + pts.len() / 2)
-            .map(|_| [(rng.next_u64() % n) as u32, (rng.next_u64() % n) as u32, (rng.next_u64() % n) as u32])
+        let n = pts.len();
+        let mut rng = Rng::new(seed);
+        let faces: Vec<[u32; 3]> = (0..1 + n / 2)
+            .map(|_| [rng.below(n) as u32, rng.below(n) as u32, rng.below(n) as u32])
             .collect();
         for m in FitMethod::ALL {
             let r = principal_axes(m, &pts, &faces);
@@ -843,10 +826,10 @@ proptest! {
 
     #[test]
     fn prop_hull_of_noisy_box_surfaces(seed in any::<u64>(), noise in 0.0f64..1e-6, n in 4usize..400) {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let pos: Vec<P> = (0..n)
             .map(|_| {
-                let axis = (rng.next_u64() % 3) as usize;
+                let axis = rng.below(3);
                 let mut q = [rng.signed(), rng.signed(), rng.signed()];
                 q[axis] = if rng.unit() < 0.5 { -1.0 } else { 1.0 };
                 [q[0] + noise * rng.signed(), q[1] + noise * rng.signed(), q[2] + noise * rng.signed()]

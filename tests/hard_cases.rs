@@ -859,7 +859,7 @@ fn near_contact_gaps_flip_contact_exactly_and_keep_the_distance_error_bound() {
 fn near_contact_under_a_common_rotation_keeps_the_distance_error_bound() {
     let mut context = QueryContext::new();
     for seed in 0..4u64 {
-        let r = common::seeded_rotation(seed);
+        let r = common::rng::seeded_rotation(seed);
         for s in [1e-3, 1.0, 1e3] {
             for o in [0.0, 1e6] {
                 for k in 1..=9 {
@@ -990,7 +990,7 @@ fn the_cube_gets_a_tight_box_in_any_orientation() {
     // arbitrary (§3.5.2): a box in a wrong frame can be up to 3^(3/2) = 5.2 times larger.
     // The fit resolves the tie from the hull's geometry; check the root box is the cube.
     for seed in 0..8u64 {
-        let r = common::seeded_rotation(seed);
+        let r = common::rng::seeded_rotation(seed);
         let cube = common::cube(1.0);
         let rotated: Vec<[f64; 3]> = cube
             .vertices()

@@ -9,8 +9,9 @@
 mod common;
 
 use common::mutate::{
-    entry_offset, extreme_values, read_uint, write_uint, Rng, ENTRY_FIELDS, HEADER_FIELDS,
+    entry_offset, extreme_values, read_uint, write_uint, ENTRY_FIELDS, HEADER_FIELDS,
 };
+use common::rng::Rng;
 use common::seal::seal;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;

@@ -18,8 +18,9 @@ mod common;
 
 use common::mutate::{
     entry_field, entry_offset, exercise, extreme_values, read_uint, write_uint, Outcome, Poses,
-    Rng, Tally, ENTRY_FIELDS, HEADER_FIELDS,
+    Tally, ENTRY_FIELDS, HEADER_FIELDS,
 };
+use common::rng::Rng;
 use common::seal::seal;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;

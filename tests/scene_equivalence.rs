@@ -121,14 +121,6 @@ fn pose(p: &[f64; 6]) -> Pose {
     Pose::new(*r.matrix(), Vector3::new(p[0], p[1], p[2]) * 1.5).unwrap()
 }
 
-/// xorshift, for the incoherent jumps.
-fn next(state: &mut u64) -> f64 {
-    *state ^= *state << 13;
-    *state ^= *state >> 7;
-    *state ^= *state << 17;
-    (*state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-}
-
 fn run_case(
     kind: usize,
     objects: &[ObjectCase],
@@ -155,7 +147,7 @@ fn run_case(
     let mut naive = builder.build().unwrap();
     naive.set_naive(true);
     let mut poses: Vec<Pose> = objects.iter().map(|o| pose(&o.start)).collect();
-    let mut random = seed | 1;
+    let mut random = common::rng::Rng::new(seed);
     for f in 0..frames {
         let mut frame = Frame::new();
         for (k, o) in objects.iter().enumerate() {
@@ -173,7 +165,7 @@ fn run_case(
                 // Some frames it stays, so reuse is exercised too.
                 Motion::Incoherent if f % 3 == 1 => continue,
                 Motion::Incoherent => {
-                    let p: [f64; 6] = std::array::from_fn(|_| next(&mut random));
+                    let p: [f64; 6] = std::array::from_fn(|_| random.signed());
                     pose(&p)
                 }
             };

@@ -68,7 +68,7 @@ fn concentric_spheres_distance_matches_brute_force() {
     let a = triangles(&inner, &Pose::identity());
     let mut context = QueryContext::new();
     for seed in 0..3u64 {
-        let pose = Pose::new(common::seeded_rotation(seed), Vector3::zeros()).unwrap();
+        let pose = Pose::new(common::rng::seeded_rotation(seed), Vector3::zeros()).unwrap();
         let b = triangles(&outer, &pose);
         let brute = a
             .iter()

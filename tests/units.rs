@@ -64,7 +64,7 @@ fn poses(shifts: &[f64]) -> Vec<Pose> {
         .enumerate()
         .map(|(seed, &x)| {
             let t = nalgebra::Vector3::new(x, 0.1 * x, -0.05);
-            Pose::new(common::seeded_rotation(seed as u64 + 7), t).expect("a rotation")
+            Pose::new(common::rng::seeded_rotation(seed as u64 + 7), t).expect("a rotation")
         })
         .collect()
 }

@@ -5,6 +5,7 @@
 #[cfg(test)]
 pub mod cli;
 pub mod mutate;
+pub mod rng;
 pub mod seal;
 
 use obbtree::mesh::TriMesh;
@@ -231,28 +232,14 @@ pub fn assert_tight_enough<B: obbtree::bv::BoundingVolume>(
     }
 }
 
-/// A deterministic pseudo-random rotation from a seed (xorshift; uniform enough for scenes).
-pub fn seeded_rotation(seed: u64) -> nalgebra::Matrix3<f64> {
-    let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-    let mut next = || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let (a, b, c) = (
-        next() * std::f64::consts::TAU,
-        next() * std::f64::consts::TAU,
-        next() * std::f64::consts::TAU,
-    );
-    *nalgebra::Rotation3::from_euler_angles(a, b, c).matrix()
-}
-
 /// The sliding-sphere scene of the dissertation's §5.3.1: B (radius 0.8) at `x` along the
 /// x axis with a seeded random rotation, A (radius 1) at the origin.
 pub fn sliding_pose(x: f64, seed: u64) -> obbtree::query::Pose {
-    obbtree::query::Pose::new(seeded_rotation(seed), nalgebra::Vector3::new(x, 0.0, 0.0))
-        .expect("rotation")
+    obbtree::query::Pose::new(
+        rng::seeded_rotation(seed),
+        nalgebra::Vector3::new(x, 0.0, 0.0),
+    )
+    .expect("rotation")
 }
 
 /// The default tree of `mesh` in f64 (the scenes compare against f64 brute force).
