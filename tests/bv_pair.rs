@@ -1,10 +1,13 @@
 //! Pair tests of volumes under a relative pose: overlap is conservative, the distance lower
 //! bound is a lower bound, the box maximum distance is exact.
 
+mod common;
+
+use common::oracle;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use obbtree::bv::pair::{BoxPair, Transform, SAT_GUARD};
 use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
-use obbtree::query::triangle::triangle_distance;
+use obbtree::query::triangle::Triangle;
 use proptest::prelude::*;
 
 fn rotation(ax: f64, ay: f64, az: f64) -> Matrix3<f64> {
@@ -98,34 +101,27 @@ fn arb_transform() -> impl Strategy<Value = Transform> {
         })
 }
 
-/// The exact distance between the surfaces of two boxes (B mapped by `xf`): the least
-/// distance between their 12 face triangles each. For boxes that do not overlap this is
-/// the box distance.
-fn surface_distance(a: &Obb<f64>, b: &Obb<f64>, xf: &Transform) -> f64 {
-    let triangles = |o: &Obb<f64>, mapped: bool| {
-        let c = corners(o);
-        let c: Vec<Vector3<f64>> = if mapped {
-            c.iter().map(|p| xf.apply(p)).collect()
-        } else {
-            c
-        };
-        // Corner k has bit i set when it lies on the + side of axis i (see `corners`).
-        let mut out = Vec::new();
-        for axis in 0..3 {
-            for side in [0, 1 << axis] {
-                let on: Vec<usize> = (0..8).filter(|k| k & (1 << axis) == side).collect();
-                // The four corners of a face, in cyclic order: 0, 1, 3, 2 of the two free bits.
-                let quad = [on[0], on[1], on[3], on[2]];
-                out.push([c[quad[0]], c[quad[1]], c[quad[2]]]);
-                out.push([c[quad[0]], c[quad[2]], c[quad[3]]]);
-            }
+/// The 12 face triangles of a box, mapped by `xf`.
+fn surface(o: &Obb<f64>, xf: &Transform) -> Vec<Triangle> {
+    let c: Vec<Vector3<f64>> = corners(o).iter().map(|p| xf.apply(p)).collect();
+    // Corner k has bit i set when it lies on the + side of axis i (see `corners`).
+    let mut out = Vec::new();
+    for axis in 0..3 {
+        for side in [0, 1 << axis] {
+            let on: Vec<usize> = (0..8).filter(|k| k & (1 << axis) == side).collect();
+            // The four corners of a face, in cyclic order: 0, 1, 3, 2 of the two free bits.
+            let quad = [on[0], on[1], on[3], on[2]];
+            out.push([c[quad[0]], c[quad[1]], c[quad[2]]]);
+            out.push([c[quad[0]], c[quad[2]], c[quad[3]]]);
         }
-        out
-    };
-    let (ta, tb) = (triangles(a, false), triangles(b, true));
-    ta.iter()
-        .flat_map(|x| tb.iter().map(move |y| triangle_distance(x, y).distance))
-        .fold(f64::INFINITY, f64::min)
+    }
+    out
+}
+
+/// The exact distance between the surfaces of two boxes (B mapped by `xf`). For boxes
+/// that do not overlap this is the box distance.
+fn surface_distance(a: &Obb<f64>, b: &Obb<f64>, xf: &Transform) -> f64 {
+    oracle::min_distance(&surface(a, &Transform::identity()), &surface(b, xf))
 }
 
 proptest! {
@@ -133,7 +129,7 @@ proptest! {
 
     #[test]
     fn box_max_distance_is_the_corner_maximum(a in arb_box(), b in arb_box(), xf in arb_transform()) {
-        let brute = corners(&a).iter().flat_map(|p| corners(&b).into_iter().map(move |q| (p - xf.apply(&q)).norm())).fold(0.0, f64::max);
+        let brute = oracle::max_distance(&surface(&a, &Transform::identity()), &surface(&b, &xf));
         let fast = a.max_distance_upper_bound(&b, &xf);
         // An upper bound, above the corner maximum by at most the slack of f64 frames
         // (1e-10 x half-widths and offset) and rounding.

@@ -8,11 +8,12 @@
 
 mod common;
 
+use common::oracle;
 use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
-use obbtree::query::triangle::{triangle_distance, Triangle};
+use obbtree::query::triangle::Triangle;
 use obbtree::query::{
     collide_files, distance_files, within_tolerance_files, CollideOptions, DescentRule,
     DistanceOptions, DistanceResult, Pose, QueryContext, Stats,
@@ -149,37 +150,34 @@ fn far_distances_stay_exact() {
             ..BuildOptions::default()
         };
         let file = build(&cow, &options, None).unwrap();
-        let stored = common::file_triangles(&file);
-        let max_x = stored
+        let triangles: Vec<Triangle> = common::file_triangles(&file)
             .iter()
-            .flat_map(|(_, t)| t.iter().map(|p| p[0]))
-            .fold(f64::MIN, f64::max);
-        let min_x = stored
-            .iter()
-            .flat_map(|(_, t)| t.iter().map(|p| p[0]))
-            .fold(f64::MAX, f64::min);
-        let right: Vec<_> = stored
-            .iter()
-            .filter(|(_, t)| t.iter().any(|p| p[0] > max_x - 0.05))
+            .map(|(_, t)| t.map(Vector3::from))
             .collect();
-        let left: Vec<_> = stored
+        let max_x = triangles
             .iter()
-            .filter(|(_, t)| t.iter().any(|p| p[0] < min_x + 0.05))
+            .flatten()
+            .map(|p| p.x)
+            .fold(f64::MIN, f64::max);
+        let min_x = triangles
+            .iter()
+            .flatten()
+            .map(|p| p.x)
+            .fold(f64::MAX, f64::min);
+        let right: Vec<Triangle> = triangles
+            .iter()
+            .filter(|t| t.iter().any(|p| p.x > max_x - 0.05))
+            .copied()
+            .collect();
+        let left: Vec<Triangle> = triangles
+            .iter()
+            .filter(|t| t.iter().any(|p| p.x < min_x + 0.05))
+            .copied()
             .collect();
         for offset in OFFSETS {
             let (pose, r) = along_x(&file, offset, &mut context);
-            // B mapped into A's frame as the query maps it.
-            let xf = Pose::relative(&Pose::identity(), &pose);
-            let brute = right
-                .iter()
-                .flat_map(|(_, ta)| {
-                    let ta: Triangle = ta.map(Vector3::from);
-                    left.iter().map(move |(_, tb)| {
-                        let tb: Triangle = tb.map(|p| xf.apply(&Vector3::from(p)));
-                        triangle_distance(&ta, &tb).distance
-                    })
-                })
-                .fold(f64::INFINITY, f64::min);
+            let left_of_b = oracle::in_frame_of_a(&Pose::identity(), &pose, &left);
+            let brute = oracle::min_distance(&right, &left_of_b);
             assert!(
                 brute < offset - (max_x - min_x) + 1e-3,
                 "the slabs hold the answer"

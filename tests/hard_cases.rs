@@ -15,13 +15,14 @@
 
 mod common;
 
+use common::oracle;
 use nalgebra::{Matrix3, Vector3};
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::pair::{BoxPair, SAT_GUARD};
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
-use obbtree::query::triangle::{triangle_distance, triangles_intersect, Triangle};
+use obbtree::query::triangle::Triangle;
 use obbtree::query::{
     collide_files, distance_files, within_tolerance_files, CollideOptions, DistanceOptions, Pose,
     QueryContext,
@@ -55,11 +56,7 @@ fn stored(mesh: &TriMesh, precision: Precision) -> Vec<[f64; 3]> {
 
 /// The triangles of `mesh` as stored at `precision`, posed into the world.
 fn world_triangles(mesh: &TriMesh, precision: Precision, pose: &Pose) -> Vec<Triangle> {
-    let v = stored(mesh, precision);
-    mesh.faces()
-        .iter()
-        .map(|f| f.map(|i| pose.apply(&Vector3::from(v[i as usize]))))
-        .collect()
+    oracle::posed(&stored(mesh, precision), mesh.faces(), pose)
 }
 
 /// How far a distance derived by hand may be from one computed on coordinates rounded to
@@ -80,30 +77,6 @@ fn magnitude(triangles: &[Triangle]) -> f64 {
         .fold(0.0f64, |m, p| m.max(p.amax()))
 }
 
-/// Every contacting pair, by testing all of them.
-fn brute_pairs(a: &[Triangle], b: &[Triangle]) -> Vec<(u32, u32)> {
-    let mut pairs = Vec::new();
-    for (i, s) in a.iter().enumerate() {
-        for (j, t) in b.iter().enumerate() {
-            if triangles_intersect(s, t) {
-                pairs.push((i as u32, j as u32));
-            }
-        }
-    }
-    pairs
-}
-
-/// The smallest triangle-pair distance, by testing all of them.
-fn brute_distance(a: &[Triangle], b: &[Triangle]) -> f64 {
-    let mut best = f64::INFINITY;
-    for s in a {
-        for t in b {
-            best = best.min(triangle_distance(s, t).distance);
-        }
-    }
-    best
-}
-
 /// Builds `mesh` with `options`, checks the tree's invariants, and returns the file.
 fn built(mesh: &TriMesh, options: &BuildOptions) -> ObbtFile {
     let file = build(mesh, options, None).unwrap();
@@ -121,8 +94,8 @@ fn check_scene(name: &str, a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pos
         let (fa, fb) = (built(a, &options), built(b, &options));
         let ta = world_triangles(a, options.precision, pose_a);
         let tb = world_triangles(b, options.precision, pose_b);
-        let pairs = brute_pairs(&ta, &tb);
-        let reference = brute_distance(&ta, &tb);
+        let pairs = oracle::contact_pairs(&ta, &tb);
+        let reference = oracle::min_distance(&ta, &tb);
 
         let all = collide_files(
             &fa,
@@ -280,7 +253,7 @@ fn guard_case_without_the_guard_loses_real_contacts() {
     let a = common::cuboid(GUARD_HA, [0.0; 3]);
     let b = common::cuboid(GUARD_HB, [0.0; 3]);
     let pose_b = pose(nearly_orthonormal(GUARD_EPS), GUARD_T);
-    let truth = brute_pairs(
+    let truth = oracle::contact_pairs(
         &world_triangles(&a, Precision::F64, &Pose::identity()),
         &world_triangles(&b, Precision::F64, &pose_b),
     );

@@ -9,11 +9,12 @@
 
 mod common;
 
+use common::oracle;
 use nalgebra::{Rotation3, Vector3};
 use obbtree::build::build;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
-use obbtree::query::triangle::{triangle_distance, triangles_intersect, Triangle};
+use obbtree::query::triangle::{triangle_distance, Triangle};
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
     DistanceOptions, PairQuery, Pose, QueryContext,
@@ -62,36 +63,6 @@ fn pose_strategy() -> impl Strategy<Value = Pose> {
         })
 }
 
-struct Brute {
-    pairs: Vec<(u32, u32)>,
-    min_distance: f64,
-    max_distance: f64,
-}
-
-fn brute_force(a: &[Triangle], b: &[Triangle], pose_a: &Pose, pose_b: &Pose) -> Brute {
-    let xf = Pose::relative(pose_a, pose_b);
-    let b: Vec<Triangle> = b.iter().map(|t| t.map(|p| xf.apply(&p))).collect();
-    let mut out = Brute {
-        pairs: Vec::new(),
-        min_distance: f64::INFINITY,
-        max_distance: 0.0,
-    };
-    for (i, ta) in a.iter().enumerate() {
-        for (j, tb) in b.iter().enumerate() {
-            if triangles_intersect(ta, tb) {
-                out.pairs.push((i as u32, j as u32));
-            }
-            out.min_distance = out.min_distance.min(triangle_distance(ta, tb).distance);
-            for p in ta {
-                for q in tb {
-                    out.max_distance = out.max_distance.max((p - q).norm());
-                }
-            }
-        }
-    }
-    out
-}
-
 fn point_on_triangle(p: &Vector3<f64>, t: &Triangle, tolerance: f64) -> bool {
     // Distance from p to the triangle, via the primitive with a degenerate triangle.
     triangle_distance(&[*p, *p, *p], t).distance <= tolerance
@@ -108,7 +79,7 @@ fn check_all(
         let fa = build(mesh_a, &options, None).unwrap();
         let fb = build(mesh_b, &options, None).unwrap();
         let (ta, tb) = (stored(&fa), stored(&fb));
-        let brute = brute_force(&ta, &tb, pose_a, pose_b);
+        let brute = oracle::Answers::of(&ta, &oracle::in_frame_of_a(pose_a, pose_b, &tb));
         let binary = fa.info().leaf_size == 1 && fb.info().leaf_size == 1;
         for rule in DescentRule::ALL {
             let what = format!("{options:?} {rule:?}");

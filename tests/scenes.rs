@@ -3,18 +3,16 @@
 
 mod common;
 
+use common::oracle;
 use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
-use obbtree::query::triangle::{triangle_distance, triangles_intersect, Triangle};
+use obbtree::query::triangle::{triangle_distance, Triangle};
 use obbtree::query::{
     collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
 };
 
 fn triangles(mesh: &obbtree::mesh::TriMesh, pose: &Pose) -> Vec<Triangle> {
-    mesh.faces()
-        .iter()
-        .map(|f| f.map(|v| pose.apply(&Vector3::from(mesh.vertices()[v as usize]))))
-        .collect()
+    oracle::posed(mesh.vertices(), mesh.faces(), pose)
 }
 
 use common::tree_f64 as tree;
@@ -30,14 +28,7 @@ fn sliding_spheres_match_brute_force() {
         let pose = common::sliding_pose(x, step as u64);
         // Brute force in A's frame (= world, A is at the identity) with B's triangles posed.
         let b = triangles(&small, &pose);
-        let mut expected = Vec::new();
-        for (i, s) in a.iter().enumerate() {
-            for (j, t) in b.iter().enumerate() {
-                if triangles_intersect(s, t) {
-                    expected.push((i as u32, j as u32));
-                }
-            }
-        }
+        let expected = oracle::contact_pairs(&a, &b);
         let r = collide_files(
             &ta,
             &Pose::identity(),
@@ -70,10 +61,7 @@ fn concentric_spheres_distance_matches_brute_force() {
     for seed in 0..3u64 {
         let pose = Pose::new(common::rng::seeded_rotation(seed), Vector3::zeros()).unwrap();
         let b = triangles(&outer, &pose);
-        let brute = a
-            .iter()
-            .flat_map(|s| b.iter().map(move |t| triangle_distance(s, t).distance))
-            .fold(f64::INFINITY, f64::min);
+        let brute = oracle::min_distance(&a, &b);
         let r = distance_files(
             &ta,
             &Pose::identity(),
@@ -112,14 +100,8 @@ fn f32_contacts_differ_from_f64_brute_force_only_at_touching_pairs() {
         let x = 0.05 * step as f64;
         let pose = common::sliding_pose(x, 100 + step);
         let b = triangles(&small, &pose);
-        let mut expected = std::collections::BTreeSet::new();
-        for (i, s) in a.iter().enumerate() {
-            for (j, t) in b.iter().enumerate() {
-                if triangles_intersect(s, t) {
-                    expected.insert((i as u32, j as u32));
-                }
-            }
-        }
+        let expected: std::collections::BTreeSet<(u32, u32)> =
+            oracle::contact_pairs(&a, &b).into_iter().collect();
         let found: std::collections::BTreeSet<(u32, u32)> = collide_files(
             &ta,
             &Pose::identity(),

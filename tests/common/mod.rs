@@ -5,6 +5,7 @@
 #[cfg(test)]
 pub mod cli;
 pub mod mutate;
+pub mod oracle;
 pub mod rng;
 pub mod seal;
 
