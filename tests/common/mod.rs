@@ -160,77 +160,57 @@ pub fn all_options() -> Vec<obbtree::build::BuildOptions> {
     out
 }
 
-/// Checks the structural invariants of a tree through its public accessors alone: children
-/// after parents, each node reached once, leaves partitioning the faces, source ids a
-/// permutation. Returns, for each node, the leaf-ordered faces below it.
-pub fn assert_consistent<B: obbtree::bv::BoundingVolume>(
-    tree: &obbtree::tree::TreeView<'_, B>,
-) -> Vec<Vec<u32>> {
-    let n = tree.nodes().len();
-    let mut below: Vec<Vec<u32>> = vec![Vec::new(); n];
-    let mut reached = vec![false; n];
-    reached[0] = true;
-    // Children follow parents, so a reverse sweep sees every child before its parent.
-    let mut children_of = vec![Vec::new(); n];
-    for i in 0..n as u32 {
-        assert!(reached[i as usize], "node {i} is not reached from the root");
-        match (tree.children(i), tree.leaf_faces(i)) {
-            (Some(c), None) => {
-                for child in c {
-                    assert!(child > i);
-                    assert!(!reached[child as usize], "node {child} has two parents");
-                    reached[child as usize] = true;
-                    children_of[i as usize].push(child);
-                }
-            }
-            (None, Some(f)) => below[i as usize] = f.collect(),
-            other => {
-                panic!("node {i} is neither a valid internal node nor a valid leaf: {other:?}")
-            }
+/// Checks `file` with the library's validator (`verify`), then that every node's volume
+/// contains every corner of every face below it within `tolerance` model units. `verify`
+/// allows a slack relative to the model's size; an absolute `tolerance` holds volumes of
+/// models far from unit size to a tighter bound.
+pub fn assert_tight_enough(file: &obbtree::format::ObbtFile, tolerance: f64) {
+    if let Err(error) = file.verify() {
+        panic!("the file does not verify: {error}");
+    }
+    struct Tight(f64);
+    impl obbtree::format::TreeVisitor for Tight {
+        type Output = ();
+        fn visit<B: obbtree::bv::BoundingVolume>(self, tree: obbtree::tree::TreeView<'_, B>) {
+            contains_below(&tree, 0, &mut Vec::new(), self.0);
         }
     }
-    for i in (0..n).rev() {
-        let gathered: Vec<u32> = children_of[i]
-            .iter()
-            .flat_map(|&c| below[c as usize].clone())
-            .collect();
-        below[i].extend(gathered);
-    }
-    let mut root = below[0].clone();
-    root.sort_unstable();
-    assert_eq!(
-        root,
-        (0..tree.faces().len() as u32).collect::<Vec<_>>(),
-        "leaves must partition the faces"
-    );
-    let mut ids = tree.source_ids().to_vec();
-    ids.sort_unstable();
-    assert_eq!(
-        ids,
-        (0..tree.faces().len() as u32).collect::<Vec<_>>(),
-        "source ids must be a permutation"
-    );
-    below
+    file.visit(Tight(tolerance))
+        .expect("a view of the file's own type");
 }
 
-/// Checks that every node's volume contains every corner of every face below it, within
-/// `tolerance` model units.
-pub fn assert_tight_enough<B: obbtree::bv::BoundingVolume>(
+/// Descends a verified tree from node `index`, below the nodes of `path`, checking every
+/// leaf face against the volumes of all its ancestors.
+fn contains_below<B: obbtree::bv::BoundingVolume>(
     tree: &obbtree::tree::TreeView<'_, B>,
+    index: u32,
+    path: &mut Vec<u32>,
     tolerance: f64,
 ) {
-    let below = assert_consistent(tree);
-    for (i, faces) in below.iter().enumerate() {
-        let bv = &tree.nodes()[i].bv;
-        for &f in faces {
-            for (k, p) in tree.triangle(f).expect("face in bounds").iter().enumerate() {
-                assert!(
-                    bv.contains(*p, tolerance),
-                    "node {i} ({bv:?}) misses corner {k} {p:?} of face {f}"
-                );
+    use obbtree::tree::NodeKind;
+    path.push(index);
+    match tree.node_kind(index).expect("a verified tree") {
+        NodeKind::Children(children) => {
+            for child in children {
+                contains_below(tree, child, path, tolerance);
+            }
+        }
+        NodeKind::Faces(faces) => {
+            for f in faces {
+                let corners = tree.triangle(f).expect("a verified tree");
+                for &node in path.iter() {
+                    let bv = &tree.nodes()[node as usize].bv;
+                    for (k, p) in corners.iter().enumerate() {
+                        assert!(
+                            bv.contains(*p, tolerance),
+                            "node {node} ({bv:?}) misses corner {k} {p:?} of face {f}"
+                        );
+                    }
+                }
             }
         }
     }
+    path.pop();
 }
 
 /// The sliding-sphere scene of the dissertation's §5.3.1: B (radius 0.8) at `x` along the
