@@ -185,10 +185,11 @@ fn obj_corner_forms_keep_only_the_position_index() {
 }
 
 #[test]
-fn obj_statements_tobj_mishandles_are_tolerated() {
+fn obj_statements_other_readers_mishandle_are_tolerated() {
     // CRLF endings, a Latin-1 comment, a UTF-8 BOM, per-vertex colours on one
     // vertex only, a `w` weight, a bare `usemtl`, and `l` / `p` statements:
-    // tobj alone fails on several of these or turns `l 1 2 3` into a triangle.
+    // general OBJ readers (tobj, once used here) fail on several of these or
+    // turn `l 1 2 3` into a triangle.
     let mut text = b"\xef\xbb\xbfv 0 0 0 1 0 0\r\n# caf\xe9\r\n".to_vec();
     text.extend_from_slice(b"v 1 0 0\r\nv 0 1 0 2\r\nv 0 0 1\r\nusemtl\r\ns off\r\n");
     text.extend_from_slice(b"l 1 2 3\r\np 4\r\nf 1 2 3\r\nf 1 2 4\r\n");
@@ -200,7 +201,8 @@ fn obj_statements_tobj_mishandles_are_tolerated() {
 
 #[test]
 fn obj_texture_and_normal_indices_are_ignored_even_when_absurd() {
-    // These make tobj 4.0.5 panic (index overflow), in release builds too.
+    // These made tobj 4.0.5, once used here, panic (index overflow) even in
+    // release builds; a soup reads no texture or normal index.
     let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
     for face in [
         "f 1//6148914691236517206 2//1 3//1",
@@ -379,6 +381,21 @@ fn obj_bad_faces_name_their_line() {
         assert!(message.starts_with("gen.obj:4: "), "{face}: {message}");
         assert!(message.contains(quoted), "{face}: {message}");
     }
+}
+
+#[test]
+fn obj_reports_the_first_problem_in_reading_order() {
+    // A NaN on line 2 comes before a short face on line 4 and an index out of range on
+    // line 3; within a line, the corners are read left to right before their count.
+    let text = b"v 0 0 0\nv nan 0 0\nf 1 2 7\nf 1 2\n";
+    let (error, message) = obj_err(text);
+    assert!(matches!(error, MeshError::NonFinite { .. }), "{error:?}");
+    assert!(message.starts_with("gen.obj:2: "), "{message}");
+    let (_, message) = obj_err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x\n");
+    assert!(
+        message.starts_with("gen.obj:4: bad face index"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -144,15 +144,6 @@ pub enum MeshError {
         /// The cap.
         limit: u64,
     },
-    /// tobj rejected an OBJ file for a reason the line scan could not pin down
-    /// (not expected to happen: every rejection known to us is located).
-    #[error("{file}: OBJ parser (tobj) failed: {message}")]
-    Obj {
-        /// The input name.
-        file: String,
-        /// tobj's error.
-        message: String,
-    },
 }
 
 /// The explanation of a [`MeshError::BinaryStlLength`].

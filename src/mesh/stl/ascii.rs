@@ -17,9 +17,9 @@
 use std::str::SplitWhitespace;
 
 use crate::mesh::error::quote;
-use crate::mesh::text::{decode, numbered_lines, NumberedLines};
+use crate::mesh::text::{coordinate, decode, numbered_lines, NumberedLines};
 use crate::mesh::weld::Welder;
-use crate::mesh::{Location, MeshError, Place, TriMesh, MAX_TRIANGLES, MAX_VERTICES};
+use crate::mesh::{MeshError, TriMesh, MAX_TRIANGLES, MAX_VERTICES};
 
 /// Parses an ASCII STL; `file` names it in errors.
 pub(super) fn parse(bytes: &[u8], file: &str) -> Result<TriMesh, MeshError> {
@@ -151,15 +151,6 @@ impl<'a> Tokens<'a> {
     /// Consumes a finite vertex coordinate.
     fn coordinate(&mut self) -> Result<f64, MeshError> {
         let word = self.next_or_eof("a vertex coordinate")?;
-        let value: f64 = word
-            .parse()
-            .map_err(|_| self.error(format!("bad vertex coordinate {}", quote(word))))?;
-        if !value.is_finite() {
-            return Err(MeshError::NonFinite {
-                place: Place::new(self.file, Location::Line(self.line)),
-                value,
-            });
-        }
-        Ok(value)
+        coordinate(word, self.file, self.line)
     }
 }
