@@ -9,7 +9,8 @@
 mod common;
 
 use common::mutate::{
-    entry_offset, extreme_values, read_uint, write_uint, ENTRY_FIELDS, HEADER_FIELDS,
+    entry_field, entry_offset, extreme_values, header_field, read_uint, write_uint, ENTRY_FIELDS,
+    HEADER_FIELDS,
 };
 use common::rng::Rng;
 use common::seal::seal;
@@ -151,7 +152,8 @@ fn damage(original: &[u8], rng: &mut Rng) -> (String, Vec<u8>) {
             let cut = rng.below(len);
             bytes.truncate(cut);
             if cut >= 128 && rng.below(2) == 0 {
-                write_uint(&mut bytes, 16, 8, cut as u64);
+                let (at, width) = header_field("file_bytes");
+                write_uint(&mut bytes, at, width, cut as u64);
                 seal(&mut bytes);
             }
             format!("truncated at {cut}")
@@ -165,7 +167,8 @@ fn damage(original: &[u8], rng: &mut Rng) -> (String, Vec<u8>) {
             format!("header {field} = {value}")
         }
         6 => {
-            let sections = read_uint(&bytes, 30, 2) as usize;
+            let (count_at, count_width) = header_field("section_count");
+            let sections = read_uint(&bytes, count_at, count_width) as usize;
             let index = rng.below(sections.max(1));
             let (field, at, width) = ENTRY_FIELDS[rng.below(ENTRY_FIELDS.len())];
             let values = extreme_values(width, len as u64);
@@ -177,7 +180,8 @@ fn damage(original: &[u8], rng: &mut Rng) -> (String, Vec<u8>) {
         _ => {
             // A 4-byte word inside the last section (the nodes), so packed references and
             // volumes get absurd values; re-sealed so that queries see them.
-            let nodes_at = read_uint(&bytes, entry_offset(3) + 8, 8) as usize;
+            let (offset_at, offset_width) = entry_field(3, "offset");
+            let nodes_at = read_uint(&bytes, offset_at, offset_width) as usize;
             let at = (nodes_at + rng.below(len - nodes_at)) & !3;
             let value = [
                 0,

@@ -17,8 +17,8 @@
 mod common;
 
 use common::mutate::{
-    entry_field, entry_offset, exercise, extreme_values, read_uint, write_uint, Outcome, Poses,
-    Tally, ENTRY_FIELDS, HEADER_FIELDS,
+    entry_field, entry_offset, exercise, extreme_values, header_field, read_uint, write_uint,
+    Outcome, Poses, Tally, ENTRY_FIELDS, HEADER_FIELDS,
 };
 use common::rng::Rng;
 use common::seal::seal;
@@ -263,7 +263,8 @@ fn truncations_at_section_boundaries_and_random_points_are_refused() {
         // directory must notice that sections run past the end.
         if len >= 128 {
             let mut cut = bytes.to_vec();
-            write_uint(&mut cut, 16, 8, len as u64);
+            let (at, width) = header_field("file_bytes");
+            write_uint(&mut cut, at, width, len as u64);
             seal(&mut cut);
             let o = subject.run(&cut, false, &|| format!("cut at {len}, length declared"));
             assert!(
@@ -338,7 +339,8 @@ fn directory_fields_with_extreme_values_are_refused_or_harmless() {
     for subject in small_files() {
         let original = &subject.bytes;
         let len = original.len() as u64;
-        let sections = read_uint(original, 30, 2) as usize;
+        let (count_at, count_width) = header_field("section_count");
+        let sections = read_uint(original, count_at, count_width) as usize;
         for index in 0..sections {
             for (field, at, width) in ENTRY_FIELDS {
                 let at = entry_offset(index) + at;
@@ -395,7 +397,8 @@ fn overlapping_misaligned_and_oversized_sections_are_named() {
     );
     // Header counts near u32::MAX contradict the directory (checked before any use).
     let mut bytes = original.clone();
-    write_uint(&mut bytes, 32, 4, u64::from(u32::MAX));
+    let (at, width) = header_field("triangles");
+    write_uint(&mut bytes, at, width, u64::from(u32::MAX));
     seal(&mut bytes);
     let err = ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes)).expect_err("refused");
     assert!(

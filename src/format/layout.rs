@@ -27,99 +27,159 @@ pub const SECTION_ALIGN: u64 = 64;
 pub const HEADER_SIZE: usize = 128;
 /// Size of one directory entry, bytes.
 pub const ENTRY_SIZE: usize = 40;
-/// Byte offset of the header CRC field.
-pub const HEADER_CRC_OFFSET: usize = 124;
 /// Cap on the number of directory entries, checked before the directory is read.
 pub const MAX_SECTIONS: u16 = 16;
 /// Directory flag: a reader that does not know this section's kind must refuse the file.
 pub const FLAG_REQUIRED: u32 = 1;
 
-/// The fixed 128-byte header at offset 0.
-///
-/// # Memory Layout
-///
-/// `#[repr(C)]`, alignment 1, 128 bytes; offsets are listed in `formats/obbt.md` § Header.
-/// `header_crc` is the CRC-32 (IEEE) of bytes `0..124` followed by the whole directory.
-#[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct Header {
-    /// [`SIGNATURE`].
-    pub signature: [u8; 8],
-    /// [`VERSION_MAJOR`].
-    pub version_major: U16,
-    /// The lowest minor version that defines every section of the file (0 or 1 from this
-    /// writer, see [`VERSION_MINOR`]); readers accept any.
-    pub version_minor: U16,
-    /// Bytes of header plus directory: `128 + 40 * section_count`.
-    pub header_bytes: U32,
-    /// Total file length in bytes; must equal the actual length.
-    pub file_bytes: U64,
-    /// Bounding volume tag: 1 OBB, 2 AABB, 3 sphere.
-    pub bv_kind: u8,
-    /// Stored scalar size: 4 (f32) or 8 (f64).
-    pub precision: u8,
-    /// Packed reference encoding: 1 binary, 2 variable branching.
-    pub encoding: u8,
-    /// Fit method tag: 1 hull, 2 triangles, 3 vertices.
-    pub fit_method: u8,
-    /// Leaf size the tree was built with (1 to 128).
-    pub leaf_size: U16,
-    /// Number of directory entries (1 to [`MAX_SECTIONS`]).
-    pub section_count: U16,
-    /// Number of triangles (faces), at least 1.
-    pub triangles: U32,
-    /// Number of vertices, at least 1.
-    pub vertices: U32,
-    /// Number of nodes, at least 1.
-    pub nodes: U32,
-    /// Number of leaf nodes.
-    pub leaves: U32,
-    /// Nodes on the longest root-to-leaf path.
-    pub depth: U32,
-    /// Zero-area triangles as stored.
-    pub degenerate_triangles: U32,
-    /// Most faces in one leaf.
-    pub max_leaf_faces: U32,
-    /// Zero.
-    pub reserved0: U32,
-    /// Componentwise minimum of the stored vertices.
-    pub bounds_min: [F64; 3],
-    /// Componentwise maximum of the stored vertices.
-    pub bounds_max: [F64; 3],
-    /// Zero.
-    pub reserved1: [u8; 12],
-    /// CRC-32 of bytes `0..124` and the directory.
-    pub header_crc: U32,
+/// Where one field of a record (the header, or a directory entry) lies in the record's
+/// bytes. Derived from the record's definition, so that no offset is ever written down twice:
+/// `open` names the byte of a bad header field with it, and tools and tests that edit raw
+/// files find fields with it ([`Header::AT`], [`SectionEntry::AT`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Field {
+    /// The field's name, as in the struct and in `formats/obbt.md`.
+    pub name: &'static str,
+    /// Bytes from the start of the record (for the header, from the start of the file).
+    pub offset: usize,
+    /// Bytes the field occupies.
+    pub width: usize,
 }
 
-/// One directory entry; the directory follows the header immediately.
-///
-/// # Memory Layout
-///
-/// `#[repr(C)]`, alignment 1, 40 bytes: kind, flags, offset, length, count, stride, crc32.
-#[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
-#[repr(C)]
-pub struct SectionEntry {
-    /// What the section holds; see [`SectionKind`].
-    pub kind: U32,
-    /// Bit 0: [`FLAG_REQUIRED`]; other bits zero.
-    pub flags: U32,
-    /// Byte offset from the start of the file, a multiple of [`SECTION_ALIGN`].
-    pub offset: U64,
-    /// Byte length: `count * stride`.
-    pub length: U64,
-    /// Number of records.
-    pub count: U64,
-    /// Bytes per record.
-    pub stride: U32,
-    /// CRC-32 (IEEE) of the section's `length` bytes.
-    pub crc32: U32,
+/// Declares an on-disk record and, from the same field list, `$fields`: a struct with one
+/// [`Field`] per field, filled by `offset_of!` and `size_of` as the record's `AT` constant.
+/// The field list is written once, so the table cannot drift from the layout.
+macro_rules! record {
+    (
+        $fields:ident;
+        $(#[$meta:meta])*
+        pub struct $name:ident {
+            $( $(#[$field_meta:meta])* pub $field:ident: $ty:ty, )*
+        }
+    ) => {
+        $(#[$meta])*
+        pub struct $name {
+            $( $(#[$field_meta])* pub $field: $ty, )*
+        }
+
+        #[doc = concat!("Where each field of [`", stringify!($name), "`] lies: [`",
+            stringify!($name), "::AT`].")]
+        #[derive(Clone, Copy, Debug)]
+        pub struct $fields {
+            $(
+                #[doc = concat!("Where `", stringify!($field), "` lies.")]
+                pub $field: Field,
+            )*
+        }
+
+        impl $name {
+            /// Where each field lies, computed from this definition.
+            pub const AT: $fields = $fields {
+                $(
+                    $field: Field {
+                        name: stringify!($field),
+                        offset: std::mem::offset_of!($name, $field),
+                        width: std::mem::size_of::<$ty>(),
+                    },
+                )*
+            };
+        }
+    };
+}
+
+record! {
+    HeaderFields;
+    /// The fixed 128-byte header at offset 0.
+    ///
+    /// # Memory Layout
+    ///
+    /// `#[repr(C)]`, alignment 1, 128 bytes; offsets are listed in `formats/obbt.md` § Header
+    /// and, computed from this definition, in [`Header::AT`]. `header_crc` is the CRC-32
+    /// (IEEE) of bytes `0..124` followed by the whole directory.
+    #[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+    #[repr(C)]
+    pub struct Header {
+        /// [`SIGNATURE`].
+        pub signature: [u8; 8],
+        /// [`VERSION_MAJOR`].
+        pub version_major: U16,
+        /// The lowest minor version that defines every section of the file (0 or 1 from this
+        /// writer, see [`VERSION_MINOR`]); readers accept any.
+        pub version_minor: U16,
+        /// Bytes of header plus directory: `128 + 40 * section_count`.
+        pub header_bytes: U32,
+        /// Total file length in bytes; must equal the actual length.
+        pub file_bytes: U64,
+        /// Bounding volume tag: 1 OBB, 2 AABB, 3 sphere.
+        pub bv_kind: u8,
+        /// Stored scalar size: 4 (f32) or 8 (f64).
+        pub precision: u8,
+        /// Packed reference encoding: 1 binary, 2 variable branching.
+        pub encoding: u8,
+        /// Fit method tag: 1 hull, 2 triangles, 3 vertices.
+        pub fit_method: u8,
+        /// Leaf size the tree was built with (1 to 128).
+        pub leaf_size: U16,
+        /// Number of directory entries (1 to [`MAX_SECTIONS`]).
+        pub section_count: U16,
+        /// Number of triangles (faces), at least 1.
+        pub triangles: U32,
+        /// Number of vertices, at least 1.
+        pub vertices: U32,
+        /// Number of nodes, at least 1.
+        pub nodes: U32,
+        /// Number of leaf nodes.
+        pub leaves: U32,
+        /// Nodes on the longest root-to-leaf path.
+        pub depth: U32,
+        /// Zero-area triangles as stored.
+        pub degenerate_triangles: U32,
+        /// Most faces in one leaf.
+        pub max_leaf_faces: U32,
+        /// Zero.
+        pub reserved0: U32,
+        /// Componentwise minimum of the stored vertices.
+        pub bounds_min: [F64; 3],
+        /// Componentwise maximum of the stored vertices.
+        pub bounds_max: [F64; 3],
+        /// Zero.
+        pub reserved1: [u8; 12],
+        /// CRC-32 of bytes `0..124` and the directory.
+        pub header_crc: U32,
+    }
+}
+
+record! {
+    EntryFields;
+    /// One directory entry; the directory follows the header immediately.
+    ///
+    /// # Memory Layout
+    ///
+    /// `#[repr(C)]`, alignment 1, 40 bytes: kind, flags, offset, length, count, stride, crc32
+    /// (offsets in [`SectionEntry::AT`]).
+    #[derive(Clone, Copy, Debug, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned)]
+    #[repr(C)]
+    pub struct SectionEntry {
+        /// What the section holds; see [`SectionKind`].
+        pub kind: U32,
+        /// Bit 0: [`FLAG_REQUIRED`]; other bits zero.
+        pub flags: U32,
+        /// Byte offset from the start of the file, a multiple of [`SECTION_ALIGN`].
+        pub offset: U64,
+        /// Byte length: `count * stride`.
+        pub length: U64,
+        /// Number of records.
+        pub count: U64,
+        /// Bytes per record.
+        pub stride: U32,
+        /// CRC-32 (IEEE) of the section's `length` bytes.
+        pub crc32: U32,
+    }
 }
 
 const _: () = {
     assert!(std::mem::size_of::<Header>() == HEADER_SIZE);
     assert!(std::mem::size_of::<SectionEntry>() == ENTRY_SIZE);
-    assert!(std::mem::offset_of!(Header, header_crc) == HEADER_CRC_OFFSET);
 };
 
 /// The placement record of the optional `placement` section (format 1.1): how the stored
@@ -258,7 +318,7 @@ pub fn header_crc(header_bytes: &[u8], directory: &[u8]) -> u32 {
     let mut h = crc32fast::Hasher::new();
     h.update(
         header_bytes
-            .get(..HEADER_CRC_OFFSET)
+            .get(..Header::AT.header_crc.offset)
             .unwrap_or(header_bytes),
     );
     h.update(directory);

@@ -3,7 +3,7 @@
 use super::aligned::AlignedBytes;
 use super::error::{FormatError, OpenError, VerifyError};
 use super::layout::{
-    align_up, header_crc, vertex_stride, Header, PlacementRecord, SectionEntry, SectionKind,
+    align_up, header_crc, vertex_stride, Field, Header, PlacementRecord, SectionEntry, SectionKind,
     ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, PLACEMENT_STRIDE, SECTION_ALIGN,
     SIGNATURE, VERSION_MAJOR,
 };
@@ -154,10 +154,11 @@ fn node_size(bv: BvKind, precision: Precision) -> usize {
 const SECTION_ALIGN_BYTES: usize = 64;
 const _: () = assert!(SECTION_ALIGN_BYTES as u64 == SECTION_ALIGN);
 
-fn field(field: &'static str, offset: usize, problem: impl Into<String>) -> FormatError {
+/// The error for header field `at` (offsets from [`Header::AT`]).
+fn field(at: Field, problem: impl Into<String>) -> FormatError {
     FormatError::HeaderField {
-        field,
-        offset,
+        field: at.name,
+        offset: at.offset,
         problem: problem.into(),
     }
 }
@@ -376,6 +377,7 @@ struct Checked {
 /// directory whose sections are in bounds, aligned, disjoint and consistent with the header.
 fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
     let len = bytes.len() as u64;
+    let at = Header::AT;
     let too_short = |needed: u64| FormatError::TooShort { len, needed };
     let head = bytes
         .get(..HEADER_SIZE)
@@ -391,8 +393,7 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
     let count = header.section_count.get();
     if count == 0 || count > MAX_SECTIONS {
         return Err(field(
-            "section_count",
-            30,
+            at.section_count,
             format!("{count} is outside 1..={MAX_SECTIONS}"),
         ));
     }
@@ -402,8 +403,7 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
         .saturating_add(HEADER_SIZE);
     if header.header_bytes.get() as usize != header_bytes {
         return Err(field(
-            "header_bytes",
-            12,
+            at.header_bytes,
             format!(
                 "{} but {count} sections need {header_bytes}",
                 header.header_bytes.get()
@@ -426,38 +426,37 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             actual: len,
         });
     }
-    let bv = BvKind::from_tag(header.bv_kind)
-        .ok_or_else(|| field("bv_kind", 24, format!("unknown tag {}", header.bv_kind)))?;
+    let unknown = |at: Field, tag: u8| field(at, format!("unknown tag {tag}"));
+    let bv = BvKind::from_tag(header.bv_kind).ok_or_else(|| unknown(at.bv_kind, header.bv_kind))?;
     let precision = Precision::from_tag(header.precision)
-        .ok_or_else(|| field("precision", 25, format!("unknown tag {}", header.precision)))?;
-    let encoding = Encoding::from_tag(header.encoding)
-        .ok_or_else(|| field("encoding", 26, format!("unknown tag {}", header.encoding)))?;
-    let fit = FitMethod::from_tag(header.fit_method).ok_or_else(|| {
-        field(
-            "fit_method",
-            27,
-            format!("unknown tag {}", header.fit_method),
-        )
-    })?;
+        .ok_or_else(|| unknown(at.precision, header.precision))?;
+    let encoding =
+        Encoding::from_tag(header.encoding).ok_or_else(|| unknown(at.encoding, header.encoding))?;
+    let fit = FitMethod::from_tag(header.fit_method)
+        .ok_or_else(|| unknown(at.fit_method, header.fit_method))?;
     let leaf_size = u32::from(header.leaf_size.get());
     if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&leaf_size) {
         return Err(field(
-            "leaf_size",
-            28,
+            at.leaf_size,
             format!("{leaf_size} is outside 1..={VARIABLE_MAX_LEAF_FACES}"),
         ));
     }
-    for (name, offset, value) in [
-        ("triangles", 32, header.triangles.get()),
-        ("vertices", 36, header.vertices.get()),
-        ("nodes", 40, header.nodes.get()),
+    for (count, value) in [
+        (at.triangles, header.triangles.get()),
+        (at.vertices, header.vertices.get()),
+        (at.nodes, header.nodes.get()),
     ] {
         if value == 0 {
-            return Err(field(name, offset, "is zero"));
+            return Err(field(count, "is zero"));
         }
     }
     if header.reserved0.get() != 0 || header.reserved1 != [0; 12] {
-        return Err(field("reserved", 60, "reserved bytes are not zero"));
+        // One message for both reserved fields, at the first.
+        let reserved = Field {
+            name: "reserved",
+            ..at.reserved0
+        };
+        return Err(field(reserved, "reserved bytes are not zero"));
     }
 
     let expected = |kind: SectionKind| -> (u64, u32) {
@@ -590,8 +589,7 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
         .saturating_sub(1);
     if encoding == Encoding::Binary && u64::from(header.nodes.get()) != binary_nodes {
         return Err(field(
-            "nodes",
-            40,
+            at.nodes,
             "a binary tree with one face per leaf has 2 x triangles - 1 nodes",
         ));
     }

@@ -7,7 +7,7 @@
 //! compare its collision answer with a brute force over the file's own triangles.
 
 use obbtree::bv::pair::Transform;
-use obbtree::format::layout::{ENTRY_SIZE, HEADER_SIZE};
+use obbtree::format::layout::{Field, Header, SectionEntry, ENTRY_SIZE, HEADER_SIZE};
 use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
@@ -37,40 +37,63 @@ impl Rng {
     }
 }
 
-/// Header fields as (name, byte offset, width in bytes), from `formats/obbt.md` § Header.
-/// The signature and the CRC are left out: rewriting them only exercises the first check.
-pub const HEADER_FIELDS: [(&str, usize, usize); 20] = [
-    ("version_major", 8, 2),
-    ("version_minor", 10, 2),
-    ("header_bytes", 12, 4),
-    ("file_bytes", 16, 8),
-    ("bv_kind", 24, 1),
-    ("precision", 25, 1),
-    ("encoding", 26, 1),
-    ("fit_method", 27, 1),
-    ("leaf_size", 28, 2),
-    ("section_count", 30, 2),
-    ("triangles", 32, 4),
-    ("vertices", 36, 4),
-    ("nodes", 40, 4),
-    ("leaves", 44, 4),
-    ("depth", 48, 4),
-    ("degenerate_triangles", 52, 4),
-    ("max_leaf_faces", 56, 4),
-    ("reserved0", 60, 4),
-    ("bounds_min.x", 64, 8),
-    ("bounds_max.z", 104, 8),
-];
+/// A library [`Field`] as (name, byte offset, width in bytes).
+const fn at(field: Field) -> (&'static str, usize, usize) {
+    (field.name, field.offset, field.width)
+}
 
-/// Directory entry fields as (name, offset within the entry, width in bytes).
-pub const ENTRY_FIELDS: [(&str, usize, usize); 6] = [
-    ("kind", 0, 4),
-    ("flags", 4, 4),
-    ("offset", 8, 8),
-    ("length", 16, 8),
-    ("count", 24, 8),
-    ("stride", 32, 4),
-];
+/// Header fields as (name, byte offset, width in bytes), from the library's [`Header::AT`].
+/// The signature and the CRC are left out: rewriting them only exercises the first check.
+pub const HEADER_FIELDS: [(&str, usize, usize); 20] = {
+    let h = Header::AT;
+    [
+        at(h.version_major),
+        at(h.version_minor),
+        at(h.header_bytes),
+        at(h.file_bytes),
+        at(h.bv_kind),
+        at(h.precision),
+        at(h.encoding),
+        at(h.fit_method),
+        at(h.leaf_size),
+        at(h.section_count),
+        at(h.triangles),
+        at(h.vertices),
+        at(h.nodes),
+        at(h.leaves),
+        at(h.depth),
+        at(h.degenerate_triangles),
+        at(h.max_leaf_faces),
+        at(h.reserved0),
+        // One f64 of each bound: the first of the minimum, the last of the maximum.
+        ("bounds_min.x", h.bounds_min.offset, 8),
+        ("bounds_max.z", h.bounds_max.offset + 16, 8),
+    ]
+};
+
+/// Directory entry fields as (name, offset within the entry, width in bytes), from the
+/// library's [`SectionEntry::AT`]. The CRC is left out, as in [`HEADER_FIELDS`].
+pub const ENTRY_FIELDS: [(&str, usize, usize); 6] = {
+    let e = SectionEntry::AT;
+    [
+        at(e.kind),
+        at(e.flags),
+        at(e.offset),
+        at(e.length),
+        at(e.count),
+        at(e.stride),
+    ]
+};
+
+/// Byte offset and width of the header field named `field` (see [`HEADER_FIELDS`]).
+pub fn header_field(field: &str) -> (usize, usize) {
+    let (_, at, width) = HEADER_FIELDS
+        .iter()
+        .find(|(name, _, _)| *name == field)
+        .copied()
+        .expect("a header field");
+    (at, width)
+}
 
 /// Reads a little-endian unsigned integer of `width` bytes at `at`.
 pub fn read_uint(bytes: &[u8], at: usize, width: usize) -> u64 {

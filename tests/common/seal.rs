@@ -4,14 +4,16 @@
 //! (`fuzz/harness.rs`, which includes this file by path), so it depends only on `obbtree`
 //! and `crc32fast` and never panics, whatever the bytes.
 
-use obbtree::format::layout::{header_crc, ENTRY_SIZE, HEADER_CRC_OFFSET, HEADER_SIZE};
+use obbtree::format::layout::{header_crc, Header, SectionEntry, ENTRY_SIZE, HEADER_SIZE};
 
 /// Offset of the header's little-endian u16 section count.
-const SECTION_COUNT_AT: usize = 30;
+const SECTION_COUNT_AT: usize = Header::AT.section_count.offset;
 /// Offsets inside a directory entry of its offset (u64), length (u64) and CRC (u32).
-const ENTRY_OFFSET_AT: usize = 8;
-const ENTRY_LENGTH_AT: usize = 16;
-const ENTRY_CRC_AT: usize = 36;
+const ENTRY_OFFSET_AT: usize = SectionEntry::AT.offset.offset;
+const ENTRY_LENGTH_AT: usize = SectionEntry::AT.length.offset;
+const ENTRY_CRC_AT: usize = SectionEntry::AT.crc32.offset;
+/// Offset of the header CRC (u32), the header's last field.
+const HEADER_CRC_AT: usize = Header::AT.header_crc.offset;
 
 /// Recomputes the CRC of every section whose directory entry and bytes are in bounds, then
 /// the header CRC over the header and the declared directory (cut at the end of `bytes`).
@@ -49,7 +51,7 @@ pub fn seal(bytes: &mut [u8]) {
         head,
         rest.get(..directory_end - HEADER_SIZE).unwrap_or(rest),
     );
-    if let Some(field) = bytes.get_mut(HEADER_CRC_OFFSET..HEADER_SIZE) {
+    if let Some(field) = bytes.get_mut(HEADER_CRC_AT..HEADER_SIZE) {
         field.copy_from_slice(&crc.to_le_bytes());
     }
 }
