@@ -46,7 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Four threads share the two maps; each keeps its own QueryContext (its traversal stack).
     let extent = (0..3)
-        .map(|k| a.info().bounds_max[k] - a.info().bounds_min[k])
+        .map(|k| a.info().stats.bounds_max[k] - a.info().stats.bounds_min[k])
         .fold(0.0, f64::max);
     std::thread::scope(|scope| {
         for thread in 0..4 {

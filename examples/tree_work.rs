@@ -53,7 +53,7 @@ fn main() {
     let build_ms = started.elapsed().as_secs_f64() * 1e3;
     let info = file.info();
     let diagonal = (0..3)
-        .map(|k| (info.bounds_max[k] - info.bounds_min[k]).powi(2))
+        .map(|k| (info.stats.bounds_max[k] - info.stats.bounds_min[k]).powi(2))
         .sum::<f64>()
         .sqrt();
     let mut pair = PairQuery::new(&file, &file).expect("one volume type");

@@ -220,14 +220,15 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
     let binary = info.encoding == Encoding::Binary;
     // Largest coordinate magnitude, for the tolerances of the floating-point comparisons.
     let scale = info
+        .stats
         .bounds_min
         .iter()
-        .chain(info.bounds_max.iter())
+        .chain(info.stats.bounds_max.iter())
         .fold(1.0f64, |m, c| m.max(c.abs()));
     let slack = 1e-9 * scale;
     let diagonal = (0..3)
         .map(|k| {
-            let e = info.bounds_max[k] - info.bounds_min[k];
+            let e = info.stats.bounds_max[k] - info.stats.bounds_min[k];
             e * e
         })
         .sum::<f64>()

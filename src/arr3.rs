@@ -28,6 +28,20 @@ pub(crate) fn max(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])]
 }
 
+/// Componentwise extremes `(min, max)` of `points` (zeros for none).
+pub(crate) fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    if points.is_empty() {
+        return ([0.0; 3], [0.0; 3]);
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        lo = min(lo, *p);
+        hi = max(hi, *p);
+    }
+    (lo, hi)
+}
+
 /// Rows become columns.
 #[inline(always)]
 pub(crate) fn transpose<T>(m: [[T; 3]; 3]) -> [[T; 3]; 3] {

@@ -52,8 +52,9 @@
 //! - [`format`](mod@format): the `.obbt` file: open (memory-mapped), verify, write;
 //! - [`query`]: collision, distance (exact, approximate, below a limit, tolerance) and
 //!   span between two posed trees; [`query::PairQuery`] for repeated queries of a pair;
-//! - [`bv`], [`tree`], [`fit`], [`real`]: bounding volumes, the packed tree view, frame
-//!   fitting and stored precision, for tools that look inside a tree.
+//! - [`bv`], [`tree`], [`stats`], [`fit`], [`real`]: bounding volumes, the packed tree
+//!   view, the header's tree statistics, frame fitting and stored precision, for tools that
+//!   look inside a tree.
 //!
 //! The library never panics on data it did not make: damaged files, meshes and poses
 //! give errors (see the README's robustness section).
@@ -91,4 +92,5 @@ pub mod placement;
 pub mod query;
 pub mod real;
 pub mod scene;
+pub mod stats;
 pub mod tree;

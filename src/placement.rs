@@ -44,7 +44,7 @@ impl Placement {
     /// or for no points).
     pub fn for_points(scale: f64, center: bool, points: &[[f64; 3]]) -> Placement {
         let offset = if center && !points.is_empty() {
-            let (lo, hi) = crate::build::bounds_of(points);
+            let (lo, hi) = arr3::bounds(points);
             // Halves first, so that the centre of a box spanning the whole f64 range is
             // finite too; `0 − x` rather than `−x`, so that a centre at 0 gives +0.
             arr3::map(arr3::zip(lo, hi), |(l, h)| {

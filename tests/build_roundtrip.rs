@@ -115,7 +115,7 @@ fn degenerate_and_duplicated_triangles_round_trip() {
     let mesh = TriMesh::new(vertices, faces).unwrap();
     check_mesh(&mesh);
     let info = build(&mesh, &BuildOptions::default(), None).unwrap().info();
-    assert_eq!(info.degenerate_triangles, 2);
+    assert_eq!(info.stats.degenerate_triangles, 2);
 }
 
 #[test]
@@ -175,16 +175,24 @@ fn statistics_match_the_tree() {
     let info = file.info();
     let n = mesh.faces().len() as u32;
     assert_eq!(
-        (info.triangles, info.nodes, info.leaves, info.max_leaf_faces),
+        (
+            info.triangles,
+            info.nodes,
+            info.stats.shape.leaves,
+            info.stats.shape.max_leaf_faces
+        ),
         (n, 2 * n - 1, n, 1)
     );
     assert!(
-        info.depth > (f64::from(n).log2().ceil() as u32),
+        info.stats.shape.depth > (f64::from(n).log2().ceil() as u32),
         "depth {}",
-        info.depth
+        info.stats.shape.depth
     );
     for k in 0..3 {
-        assert!((info.bounds_min[k] + 2.0).abs() < 1e-6 && (info.bounds_max[k] - 2.0).abs() < 1e-6);
+        assert!(
+            (info.stats.bounds_min[k] + 2.0).abs() < 1e-6
+                && (info.stats.bounds_max[k] - 2.0).abs() < 1e-6
+        );
     }
     let file4 = build(
         &mesh,
@@ -196,7 +204,11 @@ fn statistics_match_the_tree() {
     )
     .unwrap();
     let info4 = file4.info();
-    assert!(info4.max_leaf_faces <= 4 && info4.leaves < n && info4.nodes == 2 * info4.leaves - 1);
+    assert!(
+        info4.stats.shape.max_leaf_faces <= 4
+            && info4.stats.shape.leaves < n
+            && info4.nodes == 2 * info4.stats.shape.leaves - 1
+    );
 }
 
 #[test]

@@ -166,11 +166,11 @@ fn scale_and_center_place_the_model_and_are_recorded() {
         for k in 0..3 {
             let (want_lo, want_hi) = (1000.0 * (lo[k] - centre[k]), 1000.0 * (hi[k] - centre[k]));
             assert!(
-                (info.bounds_min[k] - want_lo).abs() <= tolerance
-                    && (info.bounds_max[k] - want_hi).abs() <= tolerance,
+                (info.stats.bounds_min[k] - want_lo).abs() <= tolerance
+                    && (info.stats.bounds_max[k] - want_hi).abs() <= tolerance,
                 "{precision:?} axis {k}: {:?} .. {:?}, want {want_lo} .. {want_hi}",
-                info.bounds_min,
-                info.bounds_max
+                info.stats.bounds_min,
+                info.stats.bounds_max
             );
         }
         // Every stored corner is the placement applied in f64, then rounded once.

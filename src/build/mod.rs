@@ -9,15 +9,13 @@
 mod layout;
 mod topdown;
 
-pub(crate) use layout::bounds as bounds_of;
-pub use layout::TreeStats;
-
 use crate::bv::{Aabb, BoundingVolume, BvKind, Obb, Sphere};
 use crate::fit::FitMethod;
 use crate::format::{self, ObbtFile};
 use crate::mesh::TriMesh;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
+use crate::stats::{TreeShape, TreeStats};
 use crate::tree::{EncodeError, BINARY_MAX_FACE, VARIABLE_MAX_LEAF_FACES};
 use std::borrow::Cow;
 use std::sync::atomic::AtomicU64;
@@ -237,16 +235,15 @@ fn build_as<B: BoundingVolume>(
         });
     }
     // The statistics that do not depend on the tree are found alongside it.
-    let (draft, (degenerate, bounds)) = rayon::join(
+    let (draft, stats) = rayon::join(
         || topdown::build_drafts::<B>(&positions, mesh.faces(), options, progress),
-        || {
-            (
-                layout::degenerate_count(&positions, mesh.faces()),
-                bounds_of(&positions),
-            )
-        },
+        || TreeStats::new(TreeShape::default(), &positions, mesh.faces()),
     );
-    let tree = layout::finish(draft, stored, degenerate, bounds, placement);
+    let stats = TreeStats {
+        shape: draft.shape,
+        ..stats
+    };
+    let tree = layout::finish(draft, stored, stats, placement);
     format::serialize(&tree, options)
 }
 

@@ -8,6 +8,7 @@
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
 use crate::fit::{principal_axes, principal_axes_and_vertices, FitMethod};
+use crate::stats::TreeShape;
 use crate::tree::NodeRef;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -40,8 +41,8 @@ impl<B> Draft<B> {
 pub(crate) struct DraftTree<B> {
     /// The node array as consecutive pieces (see [`Piece`]).
     pub pieces: Vec<Piece<B>>,
-    /// Leaf statistics of the tree.
-    pub shape: Shape,
+    /// Leaf statistics of the tree, gathered as it is built.
+    pub shape: TreeShape,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
 }
@@ -50,35 +51,6 @@ impl<B: Copy> DraftTree<B> {
     /// Number of nodes.
     pub fn node_count(&self) -> usize {
         self.pieces.iter().map(Piece::len).sum()
-    }
-}
-
-/// What the file header records of a tree's leaves, gathered as the tree is built.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct Shape {
-    /// Number of leaves.
-    pub leaves: u32,
-    /// Nodes on the longest root-to-leaf path.
-    pub depth: u32,
-    /// Most faces in one leaf.
-    pub max_leaf_faces: u32,
-}
-
-impl Shape {
-    /// Counts a leaf of `faces` triangles at `depth` (the root at 1).
-    fn leaf(&mut self, depth: u32, faces: u32) {
-        self.leaves += 1;
-        self.depth = self.depth.max(depth);
-        self.max_leaf_faces = self.max_leaf_faces.max(faces);
-    }
-
-    /// A parent over subtrees of these shapes.
-    fn parent(left: Shape, right: Shape) -> Shape {
-        Shape {
-            leaves: left.leaves + right.leaves,
-            depth: 1 + left.depth.max(right.depth),
-            max_leaf_faces: left.max_leaf_faces.max(right.max_leaf_faces),
-        }
     }
 }
 
@@ -130,11 +102,11 @@ const PARALLEL_MAX_DEPTH: u32 = 20;
 /// A subtree as built: one task's drafts in local layout (root at 0), or a node split
 /// into two tasks with the subtrees of its halves.
 enum Subtree<B> {
-    Serial(Vec<Draft<B>>, Shape),
+    Serial(Vec<Draft<B>>, TreeShape),
     Split {
         bv: B,
         len: usize,
-        shape: Shape,
+        shape: TreeShape,
         left: Box<Subtree<B>>,
         right: Box<Subtree<B>>,
     },
@@ -148,7 +120,7 @@ impl<B: Copy> Subtree<B> {
         }
     }
 
-    fn shape(&self) -> Shape {
+    fn shape(&self) -> TreeShape {
         match self {
             Subtree::Serial(_, shape) | Subtree::Split { shape, .. } => *shape,
         }
@@ -395,7 +367,7 @@ fn build_parallel<B: BoundingVolume>(
     let mut scratch = Scratch::default();
     let (bv, split) = fit_and_split::<B>(ctx, faces, ids, &mut scratch);
     let Some(mid) = split else {
-        let mut shape = Shape::default();
+        let mut shape = TreeShape::default();
         shape.leaf(1, faces.len() as u32);
         let leaf = Draft {
             bv,
@@ -415,7 +387,7 @@ fn build_parallel<B: BoundingVolume>(
     Subtree::Split {
         bv,
         len: 1 + left.len() + right.len(),
-        shape: Shape::parent(left.shape(), right.shape()),
+        shape: TreeShape::parent(left.shape(), right.shape()),
         left: Box::new(left),
         right: Box::new(right),
     }
@@ -428,13 +400,13 @@ fn build_serial<B: BoundingVolume>(
     faces: &mut [[u32; 3]],
     ids: &mut [u32],
     face_offset: u32,
-) -> (Vec<Draft<B>>, Shape) {
+) -> (Vec<Draft<B>>, TreeShape) {
     let placeholder = Draft {
         bv: B::new_zeroed(),
         refs: NodeRef::Leaf { first: 0, count: 0 },
     };
     let mut nodes = vec![placeholder];
-    let mut shape = Shape::default();
+    let mut shape = TreeShape::default();
     // (node, faces start, faces end, depth)
     let mut stack = vec![(0usize, 0usize, faces.len(), 1u32)];
     let mut scratch = Scratch::default();

@@ -246,7 +246,7 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
             args.output.display(),
             info.triangles,
             info.nodes,
-            info.depth,
+            info.stats.shape.depth,
             info.bv.name(),
             info.precision.name(),
             info.fit.name(),

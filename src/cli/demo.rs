@@ -122,7 +122,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
             bv.name(),
             human_bytes(info.file_bytes),
             info.nodes,
-            info.depth,
+            info.stats.shape.depth,
             build_ms,
             open_us,
             verify_ms,
@@ -214,7 +214,7 @@ fn run_cell(dir: &std::path::Path) -> Result<(), Failure> {
 /// the pair object an application would keep.
 fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
     let cow = ObbtFile::open(path)?;
-    let extent = cow.info().bounds_max[0] - cow.info().bounds_min[0];
+    let extent = cow.info().stats.bounds_max[0] - cow.info().stats.bounds_min[0];
     let mut pair = PairQuery::new(&cow, &cow)?;
     let a = Pose::identity();
     out!("queries between two cows (A fixed, B turned 30 degrees about z and moved along x; lengths in model units):")?;

@@ -45,16 +45,16 @@ pub fn to_json(info: &Info) -> serde_json::Value {
         "triangles": info.triangles,
         "vertices": info.vertices,
         "nodes": info.nodes,
-        "leaves": info.leaves,
-        "depth": info.depth,
-        "max_leaf_faces": info.max_leaf_faces,
-        "degenerate_triangles": info.degenerate_triangles,
+        "leaves": info.stats.shape.leaves,
+        "depth": info.stats.shape.depth,
+        "max_leaf_faces": info.stats.shape.max_leaf_faces,
+        "degenerate_triangles": info.stats.degenerate_triangles,
         "bv": info.bv.name(),
         "precision": info.precision.name(),
         "fit": info.fit.name(),
         "leaf_size": info.leaf_size,
         "encoding": info.encoding.name(),
-        "bounds": {"min": info.bounds_min, "max": info.bounds_max},
+        "bounds": {"min": info.stats.bounds_min, "max": info.stats.bounds_max},
         "placement": {"scale": info.placement.scale, "offset": info.placement.offset},
         "file_bytes": info.file_bytes,
         "bytes_per_triangle": info.file_bytes as f64 / f64::from(info.triangles.max(1)),
@@ -71,18 +71,18 @@ fn print_text(name: &str, info: &Info) -> Result<(), Failure> {
     out!(
         "  triangles      {} ({} zero-area)",
         info.triangles,
-        info.degenerate_triangles
+        info.stats.degenerate_triangles
     )?;
     out!("  vertices       {}", info.vertices)?;
-    let per_leaf = match info.max_leaf_faces {
+    let per_leaf = match info.stats.shape.max_leaf_faces {
         1 => "1 face per leaf".to_string(),
         n => format!("up to {n} faces per leaf"),
     };
     out!(
         "  nodes          {} ({} leaves, depth {}, {per_leaf})",
         info.nodes,
-        info.leaves,
-        info.depth
+        info.stats.shape.leaves,
+        info.stats.shape.depth
     )?;
     out!(
         "  built with     --bv {} --precision {} --fit {} --leaf-size {} ({} encoding)",
@@ -94,8 +94,8 @@ fn print_text(name: &str, info: &Info) -> Result<(), Failure> {
     )?;
     out!(
         "  bounds         {} .. {}",
-        stored_point(info, info.bounds_min),
-        stored_point(info, info.bounds_max)
+        stored_point(info, info.stats.bounds_min),
+        stored_point(info, info.stats.bounds_max)
     )?;
     if info.placement.is_identity() {
         out!("  placement      none (stored = input coordinates)")?;

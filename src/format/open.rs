@@ -11,6 +11,7 @@ use crate::bv::{Aabb, BoundingVolume, BvKind, Node, Obb, Sphere};
 use crate::fit::FitMethod;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
+use crate::stats::{TreeShape, TreeStats};
 use crate::tree::{Encoding, TreeView, VARIABLE_MAX_LEAF_FACES};
 use std::ops::Range;
 use std::path::Path;
@@ -108,18 +109,8 @@ pub struct Info {
     pub vertices: u32,
     /// Node count.
     pub nodes: u32,
-    /// Leaf count.
-    pub leaves: u32,
-    /// Nodes on the longest root-to-leaf path.
-    pub depth: u32,
-    /// Most faces in one leaf.
-    pub max_leaf_faces: u32,
-    /// Zero-area triangles as stored.
-    pub degenerate_triangles: u32,
-    /// Componentwise minimum of the stored vertices (stored units, see `placement`).
-    pub bounds_min: [f64; 3],
-    /// Componentwise maximum of the stored vertices (stored units).
-    pub bounds_max: [f64; 3],
+    /// The tree's shape, zero-area triangles and bounds (stored units, see `placement`).
+    pub stats: TreeStats,
     /// How the stored coordinates were made from the input mesh's (identity when the file
     /// has no `placement` section).
     pub placement: Placement,
@@ -261,12 +252,16 @@ impl ObbtFile {
             triangles: h.triangles.get(),
             vertices: h.vertices.get(),
             nodes: h.nodes.get(),
-            leaves: h.leaves.get(),
-            depth: h.depth.get(),
-            max_leaf_faces: h.max_leaf_faces.get(),
-            degenerate_triangles: h.degenerate_triangles.get(),
-            bounds_min: h.bounds_min.map(|v| v.get()),
-            bounds_max: h.bounds_max.map(|v| v.get()),
+            stats: TreeStats {
+                shape: TreeShape {
+                    leaves: h.leaves.get(),
+                    depth: h.depth.get(),
+                    max_leaf_faces: h.max_leaf_faces.get(),
+                },
+                degenerate_triangles: h.degenerate_triangles.get(),
+                bounds_min: h.bounds_min.map(|v| v.get()),
+                bounds_max: h.bounds_max.map(|v| v.get()),
+            },
             placement: self.placement,
             file_bytes: h.file_bytes.get(),
             sections: self.sections.clone(),

@@ -5,11 +5,10 @@
 use super::error::VerifyError;
 use super::layout::SECTION_ALIGN;
 use super::open::{ObbtFile, TreeVisitor};
-use crate::build::TreeStats;
 use crate::bv::BoundingVolume;
-use crate::mesh::triangle_is_degenerate;
 use crate::placement::Placement;
 use crate::real::point_to_f64;
+use crate::stats::{TreeShape, TreeStats};
 use crate::tree::{NodeRef, TreeView};
 
 /// The byte range `offset .. offset + length` as indices into a buffer, if it fits one.
@@ -141,32 +140,22 @@ impl TreeVisitor for Contents<'_> {
                 Some(s) => *s = true,
             }
         }
-        check_nodes(&tree, &positions, info.leaf_size)?;
+        let shape = check_nodes(&tree, &positions, info.leaf_size)?;
 
-        let (stats, _) = TreeStats::of_nodes(
-            tree.nodes().iter().map(|n| tree.node_ref(n)),
-            tree.nodes().len(),
-        )
-        .ok_or_else(|| VerifyError::new("section nodes", "not a tree"))?;
-        // Every index was checked against `positions` above.
-        let degenerate = tree
-            .faces()
-            .iter()
-            .filter(|f| match f.map(|v| positions.get(v as usize)) {
-                [Some(&p), Some(&q), Some(&r)] => triangle_is_degenerate(p, q, r),
-                _ => false,
-            })
-            .count();
-        let degenerate = u32::try_from(degenerate).unwrap_or(u32::MAX);
-        let (lo, hi) = crate::build::bounds_of(&positions);
+        // Every face index was checked against `positions` above.
+        let (stored, actual) = (info.stats, TreeStats::new(shape, &positions, tree.faces()));
         let claims = [
-            ("leaves", info.leaves, stats.leaves),
-            ("depth", info.depth, stats.depth),
-            ("max_leaf_faces", info.max_leaf_faces, stats.max_leaf_faces),
+            ("leaves", stored.shape.leaves, actual.shape.leaves),
+            ("depth", stored.shape.depth, actual.shape.depth),
+            (
+                "max_leaf_faces",
+                stored.shape.max_leaf_faces,
+                actual.shape.max_leaf_faces,
+            ),
             (
                 "degenerate_triangles",
-                info.degenerate_triangles,
-                degenerate,
+                stored.degenerate_triangles,
+                actual.degenerate_triangles,
             ),
         ];
         for (name, stored, actual) in claims {
@@ -177,7 +166,7 @@ impl TreeVisitor for Contents<'_> {
                 ));
             }
         }
-        if lo != info.bounds_min || hi != info.bounds_max {
+        if (stored.bounds_min, stored.bounds_max) != (actual.bounds_min, actual.bounds_max) {
             return Err(VerifyError::new(
                 "header",
                 "model bounds differ from the vertices' extent",
@@ -189,18 +178,23 @@ impl TreeVisitor for Contents<'_> {
 
 /// Structure and geometry of the nodes: references in bounds and pointing forward (so every
 /// traversal terminates), each node below exactly one parent, leaves partitioning the faces,
-/// volumes well formed and containing every vertex of every face below them.
+/// volumes well formed and containing every vertex of every face below them. Returns the
+/// tree's shape, counted on the way for the header's claims.
 fn check_nodes<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     positions: &[[f64; 3]],
     leaf_size: u32,
-) -> Result<(), VerifyError> {
+) -> Result<TreeShape, VerifyError> {
     let nodes = tree.nodes();
     let n_faces = tree.faces().len() as u64;
     let bad = |i: usize, problem: String| {
         VerifyError::new("section nodes", format!("node {i}: {problem}"))
     };
     let mut parent = vec![u32::MAX; nodes.len()];
+    // Nodes on the path from the root, the root at 1; final when the node is reached, like
+    // `parent`.
+    let mut depth = vec![1u32; nodes.len()];
+    let mut shape = TreeShape::default();
     let mut face_owner = vec![u32::MAX; tree.faces().len()];
     for (i, node) in nodes.iter().enumerate() {
         // Parents come first, so a node's entry is final when it is reached.
@@ -213,6 +207,7 @@ fn check_nodes<B: BoundingVolume>(
         node.bv.validate().map_err(|d| bad(i, d.to_string()))?;
         let r = tree.node_ref(node);
         let range = r.range();
+        let node_depth = depth.get(i).copied().unwrap_or(u32::MAX);
         match r {
             NodeRef::Internal { .. } => {
                 if range.start <= i as u64 || range.end > nodes.len() as u64 {
@@ -236,6 +231,10 @@ fn check_nodes<B: BoundingVolume>(
                         return Err(bad(i, format!("child {c} already has parent {}", *slot)));
                     }
                     *slot = index;
+                    // In bounds like `slot`.
+                    if let Some(d) = usize::try_from(c).ok().and_then(|c| depth.get_mut(c)) {
+                        *d = node_depth.saturating_add(1);
+                    }
                 }
             }
             NodeRef::Leaf { count, .. } => {
@@ -254,6 +253,7 @@ fn check_nodes<B: BoundingVolume>(
                         format!("{count} faces exceed the leaf size {leaf_size}"),
                     ));
                 }
+                shape.leaf(node_depth, count);
                 for f in range {
                     // In bounds: the range was checked against the face count just above.
                     let owner = usize::try_from(f).ok().and_then(|f| face_owner.get_mut(f));
@@ -311,5 +311,5 @@ fn check_nodes<B: BoundingVolume>(
             at = *parent.get(at as usize).ok_or_else(|| unchecked("parent"))?;
         }
     }
-    Ok(())
+    Ok(shape)
 }

@@ -115,20 +115,19 @@ impl TriMesh {
     /// collinear positions (an exactly zero cross product in f64). They are
     /// kept in the mesh because they can still touch other geometry.
     pub fn degenerate_triangle_count(&self) -> usize {
-        self.faces
-            .iter()
-            .filter(|face| self.is_degenerate(face))
-            .count()
+        degenerate_count(&self.vertices, &self.faces)
     }
+}
 
-    /// Whether `face` has zero area (see [`TriMesh::degenerate_triangle_count`]).
-    fn is_degenerate(&self, face: &[u32; 3]) -> bool {
-        // Indices are validated at construction, so the lookups always succeed.
-        match face.map(|i| self.vertices.get(i as usize)) {
-            [Some(p), Some(q), Some(r)] => triangle_is_degenerate(*p, *q, *r),
-            _ => true,
-        }
-    }
+/// Number of `faces` of zero area over `vertices` (see [`triangle_is_degenerate`]): of a
+/// mesh as loaded, or of a tree's stored vertices for its header. A face with an index
+/// past `vertices` counts as degenerate (callers have checked every index).
+pub(crate) fn degenerate_count(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> usize {
+    let degenerate = |face: &&[u32; 3]| match face.map(|i| vertices.get(i as usize)) {
+        [Some(&p), Some(&q), Some(&r)] => triangle_is_degenerate(p, q, r),
+        _ => true,
+    };
+    faces.iter().filter(degenerate).count()
 }
 
 /// Whether a triangle has zero area: its edge cross product is exactly zero in f64

@@ -254,7 +254,7 @@ impl Poses {
     pub fn for_file(file: &ObbtFile) -> Poses {
         let info = file.info();
         let size = (0..3)
-            .map(|k| info.bounds_max[k] - info.bounds_min[k])
+            .map(|k| info.stats.bounds_max[k] - info.stats.bounds_min[k])
             .fold(0.0, f64::max);
         Poses::for_size(size)
     }
