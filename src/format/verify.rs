@@ -9,7 +9,7 @@ use crate::bv::BoundingVolume;
 use crate::placement::Placement;
 use crate::real::point_to_f64;
 use crate::stats::{TreeShape, TreeStats};
-use crate::tree::{NodeRef, TreeView};
+use crate::tree::{NodeDefect, NodeKind, TreeView};
 
 /// The byte range `offset .. offset + length` as indices into a buffer, if it fits one.
 fn byte_range(offset: u64, length: u64) -> Option<std::ops::Range<usize>> {
@@ -186,7 +186,7 @@ fn check_nodes<B: BoundingVolume>(
     leaf_size: u32,
 ) -> Result<TreeShape, VerifyError> {
     let nodes = tree.nodes();
-    let n_faces = tree.faces().len() as u64;
+    let n_faces = tree.faces().len();
     let bad = |i: usize, problem: String| {
         VerifyError::new("section nodes", format!("node {i}: {problem}"))
     };
@@ -205,59 +205,54 @@ fn check_nodes<B: BoundingVolume>(
         // never collides with the `u32::MAX` marker.
         let index = u32::try_from(i).map_err(|_| bad(i, "index exceeds u32".into()))?;
         node.bv.validate().map_err(|d| bad(i, d.to_string()))?;
-        let r = tree.node_ref(node);
-        let range = r.range();
         let node_depth = depth.get(i).copied().unwrap_or(u32::MAX);
-        match r {
-            NodeRef::Internal { .. } => {
-                if range.start <= i as u64 || range.end > nodes.len() as u64 {
-                    return Err(bad(
-                        i,
-                        format!(
-                            "children {}..{} are not after it and below {}",
-                            range.start,
-                            range.end,
-                            nodes.len()
-                        ),
-                    ));
-                }
-                for c in range {
-                    // In bounds: the range was checked against `nodes.len()` just above.
-                    let slot = usize::try_from(c).ok().and_then(|c| parent.get_mut(c));
-                    let Some(slot) = slot else {
+        // The references are checked by the decoder the queries use; the raw range only
+        // words the message.
+        let kind = tree.node_kind(index).map_err(|defect| {
+            let range = tree.node_ref(node).range();
+            let (start, end) = (range.start, range.end);
+            bad(
+                i,
+                match defect {
+                    NodeDefect::BadChildren => format!(
+                        "children {start}..{end} are not after it and below {}",
+                        nodes.len()
+                    ),
+                    NodeDefect::BadFaces => {
+                        format!("faces {start}..{end} exceed the {n_faces} faces")
+                    }
+                    NodeDefect::Missing => defect.to_string(),
+                },
+            )
+        })?;
+        match kind {
+            NodeKind::Children(children) => {
+                for c in children {
+                    // In bounds: `node_kind` checked the range against the node array.
+                    let (Some(slot), Some(d)) =
+                        (parent.get_mut(c as usize), depth.get_mut(c as usize))
+                    else {
                         return Err(bad(i, format!("child {c} is out of bounds")));
                     };
                     if *slot != u32::MAX {
                         return Err(bad(i, format!("child {c} already has parent {}", *slot)));
                     }
                     *slot = index;
-                    // In bounds like `slot`.
-                    if let Some(d) = usize::try_from(c).ok().and_then(|c| depth.get_mut(c)) {
-                        *d = node_depth.saturating_add(1);
-                    }
+                    *d = node_depth.saturating_add(1);
                 }
             }
-            NodeRef::Leaf { count, .. } => {
-                if range.end > n_faces {
-                    return Err(bad(
-                        i,
-                        format!(
-                            "faces {}..{} exceed the {n_faces} faces",
-                            range.start, range.end
-                        ),
-                    ));
-                }
-                if count > leaf_size {
+            NodeKind::Faces(faces) => {
+                let count = faces.len();
+                if count > leaf_size as usize {
                     return Err(bad(
                         i,
                         format!("{count} faces exceed the leaf size {leaf_size}"),
                     ));
                 }
-                shape.leaf(node_depth, count);
-                for f in range {
-                    // In bounds: the range was checked against the face count just above.
-                    let owner = usize::try_from(f).ok().and_then(|f| face_owner.get_mut(f));
-                    let Some(owner) = owner else {
+                shape.leaf(node_depth, u32::try_from(count).unwrap_or(u32::MAX));
+                for f in faces {
+                    // In bounds: `node_kind` checked the range against the face array.
+                    let Some(owner) = face_owner.get_mut(f as usize) else {
                         return Err(bad(i, format!("face {f} is out of bounds")));
                     };
                     if *owner != u32::MAX {
