@@ -59,6 +59,34 @@ impl NodeRef {
     }
 }
 
+/// A node before packing: its volume and its reference as a [`NodeRef`]. The builder makes
+/// these with indices local to a subtree; the writer moves them into place
+/// ([`Draft::shifted`]) and packs them once the tree's [`Encoding`] is known.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Draft<B> {
+    /// The node's bounding volume.
+    pub bv: B,
+    /// The node's children or faces.
+    pub refs: NodeRef,
+}
+
+impl<B> Draft<B> {
+    /// The draft with its child indices moved `by` nodes on (saturating: an index that
+    /// large is refused by every encoding).
+    pub fn shifted(self, by: u32) -> Draft<B> {
+        match self.refs {
+            NodeRef::Internal { first, count } => Draft {
+                bv: self.bv,
+                refs: NodeRef::Internal {
+                    first: first.saturating_add(by),
+                    count,
+                },
+            },
+            NodeRef::Leaf { .. } => self,
+        }
+    }
+}
+
 /// A node's contents, checked against the arrays it points into ([`TreeView::node_kind`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum NodeKind {

@@ -6,12 +6,11 @@
 //! node holds at most `leaf_size` triangles. The split rule ignores the volume type, so OBB,
 //! AABB and sphere trees of one mesh have the same shape and compare on equal footing.
 
-mod layout;
 mod topdown;
 
 use crate::bv::{Aabb, BoundingVolume, BvKind, Obb, Sphere};
 use crate::fit::FitMethod;
-use crate::format::{self, ObbtFile};
+use crate::format::{self, ObbtFile, TreeImage, WriteError};
 use crate::mesh::TriMesh;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
@@ -243,23 +242,26 @@ fn build_as<B: BoundingVolume>(
         shape: draft.shape,
         ..stats
     };
-    let tree = layout::finish(draft, stored, stats, placement);
-    format::serialize(&tree, options)
+    let image = TreeImage {
+        vertices: &stored,
+        faces: &draft.faces,
+        source_ids: &draft.source_ids,
+        nodes: draft.pieces.iter().map(topdown::Piece::run).collect(),
+        fit: options.fit,
+        // `validate` checked it against 128.
+        leaf_size: u16::try_from(options.leaf_size)
+            .map_err(|_| BuildError::LeafSize(options.leaf_size))?,
+        stats,
+        placement,
+    };
+    Ok(format::serialize(&image)?)
 }
 
-/// A finished tree in memory: the arrays of the file, before serialization.
-#[derive(Debug)]
-pub(crate) struct BuiltTree<B: BoundingVolume> {
-    pub vertices: Vec<[B::Real; 3]>,
-    pub faces: Vec<[u32; 3]>,
-    pub source_ids: Vec<u32>,
-    /// The nodes, in pieces.
-    pub nodes: Vec<topdown::Piece<B>>,
-    /// Number of nodes.
-    pub node_count: usize,
-    pub encoding: crate::tree::Encoding,
-    pub stats: TreeStats,
-    /// How the stored vertices were placed relative to the input; recorded in the file when
-    /// it is not the identity.
-    pub placement: Placement,
+impl From<WriteError> for BuildError {
+    fn from(e: WriteError) -> BuildError {
+        match e {
+            WriteError::Encode(e) => BuildError::TooLarge(e),
+            WriteError::Image(problem) => BuildError::Image(problem),
+        }
+    }
 }

@@ -8,33 +8,11 @@
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
 use crate::fit::{principal_axes, principal_axes_and_vertices, FitMethod};
+use crate::format::NodeRun;
 use crate::stats::TreeShape;
-use crate::tree::NodeRef;
+use crate::tree::{Draft, NodeRef};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
-
-/// A node during construction: indices are local to the subtree being built until merged.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Draft<B> {
-    pub bv: B,
-    pub refs: NodeRef,
-}
-
-impl<B> Draft<B> {
-    /// The draft with its child indices moved `by` nodes on.
-    pub fn shifted(self, by: u32) -> Draft<B> {
-        match self.refs {
-            NodeRef::Internal { first, count } => Draft {
-                bv: self.bv,
-                refs: NodeRef::Internal {
-                    first: first + by,
-                    count,
-                },
-            },
-            NodeRef::Leaf { .. } => self,
-        }
-    }
-}
 
 /// The drafts of a whole tree (node 0 the root, children of a node adjacent and after it),
 /// and the faces and their input ids permuted into leaf order.
@@ -45,13 +23,6 @@ pub(crate) struct DraftTree<B> {
     pub shape: TreeShape,
     pub faces: Vec<[u32; 3]>,
     pub source_ids: Vec<u32>,
-}
-
-impl<B: Copy> DraftTree<B> {
-    /// Number of nodes.
-    pub fn node_count(&self) -> usize {
-        self.pieces.iter().map(Piece::len).sum()
-    }
 }
 
 /// A run of consecutive nodes of the final array: `drafts[skip..]`, whose child indices
@@ -65,11 +36,6 @@ pub(crate) struct Piece<B> {
 }
 
 impl<B: Copy> Piece<B> {
-    /// Number of nodes.
-    pub fn len(&self) -> usize {
-        self.drafts.len().saturating_sub(self.skip)
-    }
-
     /// Sets the volume of every single-face leaf to that of its face: `volumes` by input
     /// face id, `source_ids` the input id of each leaf-ordered face.
     fn fill_leaves(&mut self, volumes: &[B], source_ids: &[u32]) {
@@ -84,9 +50,13 @@ impl<B: Copy> Piece<B> {
         }
     }
 
-    /// The nodes as built, and what to add to their child indices.
-    pub fn raw(&self) -> (&[Draft<B>], u32) {
-        (self.drafts.get(self.skip..).unwrap_or_default(), self.shift)
+    /// The piece as the writer takes it: the nodes as built, and what to add to their child
+    /// indices.
+    pub fn run(&self) -> NodeRun<'_, B> {
+        NodeRun {
+            drafts: self.drafts.get(self.skip..).unwrap_or_default(),
+            shift: self.shift,
+        }
     }
 }
 

@@ -24,5 +24,5 @@ mod write;
 pub use aligned::AlignedBytes;
 pub use error::{FormatError, OpenError, VerifyError};
 pub use open::{Info, ObbtFile, SectionInfo, TreeVisitor};
-pub(crate) use write::serialize;
 pub use write::{abandon_writes, remove_stale_temporaries, write_atomic};
+pub(crate) use write::{serialize, NodeRun, TreeImage, WriteError};

@@ -6,9 +6,12 @@ use super::layout::{
     ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, PLACEMENT_STRIDE, SIGNATURE, VERSION_MAJOR,
 };
 use super::open::ObbtFile;
-use crate::build::{BuildError, BuildOptions, BuiltTree};
 use crate::bv::{BoundingVolume, Node};
+use crate::fit::FitMethod;
+use crate::placement::Placement;
 use crate::real::{Precision, Real};
+use crate::stats::{TreeShape, TreeStats};
+use crate::tree::{Draft, EncodeError, Encoding};
 use rayon::prelude::*;
 use std::io::Write;
 use std::ops::Range;
@@ -19,26 +22,86 @@ use zerocopy::IntoBytes;
 /// Number of required sections, laid out first.
 const REQUIRED: usize = SectionKind::REQUIRED.len();
 
+/// A finished tree, as the writer takes it: the contents of every section and the header
+/// fields that a build decides. The volume type and precision are `B`'s; everything else
+/// in the header (counts, version, layout, checksums) the writer derives.
+pub(crate) struct TreeImage<'a, B: BoundingVolume> {
+    /// Stored vertices (stored frame), in input order.
+    pub vertices: &'a [[B::Real; 3]],
+    /// Faces in leaf order, as vertex indices.
+    pub faces: &'a [[u32; 3]],
+    /// The input id of each leaf-ordered face.
+    pub source_ids: &'a [u32],
+    /// The node array (node 0 the root), as consecutive runs.
+    pub nodes: Vec<NodeRun<'a, B>>,
+    /// The fit method the volumes were made with (informative).
+    pub fit: FitMethod,
+    /// The most faces a leaf was allowed, 1 to 128.
+    pub leaf_size: u16,
+    /// The header's statistics; `stats.shape` also decides the encoding.
+    pub stats: TreeStats,
+    /// How the stored vertices were made from the input's; written only when it is not the
+    /// identity.
+    pub placement: Placement,
+}
+
+/// A run of consecutive nodes of the node array: `drafts`, whose child indices become final
+/// once `shift` is added. A builder places subtrees built apart this way, without copying
+/// them.
+pub(crate) struct NodeRun<'a, B> {
+    /// The nodes, child indices `shift` short of their final value.
+    pub drafts: &'a [Draft<B>],
+    /// What to add to every child index of the run.
+    pub shift: u32,
+}
+
+/// Why a tree could not be laid out as an image.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum WriteError {
+    /// A node reference does not fit the tree's encoding: the model is too large for it.
+    #[error(transparent)]
+    Encode(#[from] EncodeError),
+    /// The image is larger than this platform can address (32-bit hosts), or (a bug) the
+    /// header written fails the reader's checks.
+    #[error("{0}")]
+    Image(String),
+}
+
 /// The error for a size this platform cannot address, or a count the format cannot hold.
-fn too_large(what: &str) -> BuildError {
-    BuildError::Image(format!(
+fn too_large(what: &str) -> WriteError {
+    WriteError::Image(format!(
         "{what} exceeds this platform's or the format's limits"
     ))
 }
 
-/// Serializes a finished tree. The layout is fully determined by the tree and options, so
-/// equal inputs give byte-identical images.
+/// The encoding this writer uses for a tree of `shape` (`formats/obbt.md` §5.5): binary
+/// exactly when every leaf holds one face. Every internal node of a built tree has two
+/// children, so single-face leaves make a binary tree; an empty mesh is one leaf of no
+/// faces, which only the variable encoding holds.
+fn encoding_for(shape: TreeShape) -> Encoding {
+    if shape.max_leaf_faces == 1 {
+        Encoding::Binary
+    } else {
+        Encoding::Variable
+    }
+}
+
+/// Serializes a finished tree. The layout is fully determined by the tree, so equal inputs
+/// give byte-identical images.
 ///
 /// Every section is encoded straight into its place in the (zero-initialised) image, so the
 /// image is the only large buffer the writer touches.
 ///
 /// Fails if a node reference does not fit the tree's encoding, or the image does not fit
 /// this platform's address space.
-pub(crate) fn serialize<B: BoundingVolume>(
-    tree: &BuiltTree<B>,
-    options: &BuildOptions,
-) -> Result<ObbtFile, BuildError> {
+pub(crate) fn serialize<B: BoundingVolume>(tree: &TreeImage<B>) -> Result<ObbtFile, WriteError> {
     let scalar = std::mem::size_of::<B::Real>();
+    let encoding = encoding_for(tree.stats.shape);
+    let node_count = tree
+        .nodes
+        .iter()
+        .try_fold(0usize, |n, run| n.checked_add(run.drafts.len()))
+        .ok_or_else(|| too_large("the node count"))?;
     // The optional placement record, written only when it says something.
     let placement = (!tree.placement.is_identity()).then(|| PlacementRecord::from(tree.placement));
     // (kind, count, stride) in file order; the byte length of each is count * stride.
@@ -52,7 +115,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
         (SectionKind::SourceIds, tree.source_ids.len() as u64, 4),
         (
             SectionKind::Nodes,
-            tree.node_count as u64,
+            node_count as u64,
             u32::try_from(Node::<B>::SIZE).map_err(|_| too_large("the node size"))?,
         ),
     ];
@@ -86,7 +149,7 @@ pub(crate) fn serialize<B: BoundingVolume>(
     let mut image = AlignedBytes::zeroed_in_parallel(len);
     let bytes = image.as_mut_bytes();
 
-    let layout_error = || BuildError::Image("sections out of bounds".into());
+    let layout_error = || WriteError::Image("sections out of bounds".into());
     let required: [Range<usize>; REQUIRED] = ranges
         .get(..REQUIRED)
         .and_then(|r| r.to_vec().try_into().ok())
@@ -101,14 +164,14 @@ pub(crate) fn serialize<B: BoundingVolume>(
     for (out, i) in faces.chunks_exact_mut(4).zip(tree.faces.iter().flatten()) {
         out.copy_from_slice(&i.to_le_bytes());
     }
-    for (out, i) in ids.chunks_exact_mut(4).zip(&tree.source_ids) {
+    for (out, i) in ids.chunks_exact_mut(4).zip(tree.source_ids) {
         out.copy_from_slice(&i.to_le_bytes());
     }
     let mut crcs = vec![
         crc32fast::hash(vertices),
         crc32fast::hash(faces),
         crc32fast::hash(ids),
-        write_nodes(tree, nodes)?,
+        write_nodes(&tree.nodes, encoding, nodes)?,
     ];
     if let Some(record) = placement {
         let out = ranges
@@ -149,19 +212,17 @@ pub(crate) fn serialize<B: BoundingVolume>(
             .into(),
         header_bytes: count32(header_bytes, "the header")?.into(),
         file_bytes: total.into(),
-        bv_kind: options.bv.tag(),
-        precision: options.precision.tag(),
-        encoding: tree.encoding.tag(),
-        fit_method: options.fit.tag(),
-        leaf_size: u16::try_from(options.leaf_size)
-            .map_err(|_| BuildError::LeafSize(options.leaf_size))?
-            .into(),
+        bv_kind: B::KIND.tag(),
+        precision: <B::Real as Real>::PRECISION.tag(),
+        encoding: encoding.tag(),
+        fit_method: tree.fit.tag(),
+        leaf_size: tree.leaf_size.into(),
         section_count: u16::try_from(sections.len())
             .map_err(|_| too_large("the section count"))?
             .into(),
         triangles: count32(tree.faces.len(), "the triangle count")?.into(),
         vertices: count32(tree.vertices.len(), "the vertex count")?.into(),
-        nodes: count32(tree.node_count, "the node count")?.into(),
+        nodes: count32(node_count, "the node count")?.into(),
         leaves: s.shape.leaves.into(),
         depth: s.shape.depth.into(),
         degenerate_triangles: s.degenerate_triangles.into(),
@@ -185,28 +246,31 @@ pub(crate) fn serialize<B: BoundingVolume>(
         .copy_from_slice(&head);
     // The reader's O(1) checks double as a check of the writer.
     ObbtFile::from_aligned(image)
-        .map_err(|e| BuildError::Image(format!("the written header fails its own checks: {e}")))
+        .map_err(|e| WriteError::Image(format!("the written header fails its own checks: {e}")))
 }
 
-/// Encodes the nodes of `tree` into `out` (exactly their size) and returns its CRC-32.
+/// Encodes the node runs `nodes` into `out` (exactly their size) and returns its CRC-32.
 ///
 /// The nodes are most of the file: they are encoded in parallel, in runs of at most
 /// `CHUNK` nodes (cut at the same places whatever the number of threads), each run's CRC
 /// taken while its bytes are still in cache and the CRCs combined in order. The first
 /// reference (in node order) that the encoding cannot hold is the error.
-fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result<u32, BuildError> {
+fn write_nodes<B: BoundingVolume>(
+    nodes: &[NodeRun<'_, B>],
+    encoding: Encoding,
+    out: &mut [u8],
+) -> Result<u32, WriteError> {
     const CHUNK: usize = 2048;
     let size = Node::<B>::SIZE;
     // (drafts, their shift, output) of each run, in order.
     let mut runs = Vec::new();
     let mut out = out;
-    for piece in &tree.nodes {
-        let (drafts, shift) = piece.raw();
+    for &NodeRun { drafts, shift } in nodes {
         for drafts in drafts.chunks(CHUNK) {
             let Some((o, rest)) =
                 std::mem::take(&mut out).split_at_mut_checked(drafts.len().saturating_mul(size))
             else {
-                return Err(BuildError::Image(
+                return Err(WriteError::Image(
                     "more nodes than the node section holds".into(),
                 ));
             };
@@ -214,8 +278,7 @@ fn write_nodes<B: BoundingVolume>(tree: &BuiltTree<B>, out: &mut [u8]) -> Result
             out = rest;
         }
     }
-    let encoding = tree.encoding;
-    let hashers: Vec<Result<crc32fast::Hasher, BuildError>> = runs
+    let hashers: Vec<Result<crc32fast::Hasher, WriteError>> = runs
         .into_par_iter()
         .map(|(drafts, shift, out)| {
             let mut record = Vec::with_capacity(size);
