@@ -15,7 +15,7 @@ use crate::stats::{TreeShape, TreeStats};
 use crate::tree::{Encoding, TreeView, VARIABLE_MAX_LEAF_FACES};
 use std::ops::Range;
 use std::path::Path;
-use zerocopy::FromBytes;
+use zerocopy::{FromBytes, FromZeros};
 
 /// Where the bytes live. Both are 64-byte aligned and immutable for the file's lifetime.
 enum Backing {
@@ -37,22 +37,23 @@ impl Backing {
 /// queries on many threads.
 pub struct ObbtFile {
     backing: Backing,
-    header: Header,
-    sections: Vec<SectionInfo>,
+    meta: Meta,
+}
+
+/// What `open` learned from the header and directory, checked and decoded once; every
+/// accessor reads it from here.
+struct Meta {
+    /// Everything the header and directory say, with the placement record decoded
+    /// (identity without one).
+    info: Info,
     /// Byte ranges of the four required sections, in [`SectionKind::REQUIRED`] order.
     required: [Range<usize>; 4],
-    bv: BvKind,
-    precision: Precision,
-    encoding: Encoding,
-    fit: FitMethod,
-    /// Decoded from the `placement` section on open (identity without one).
-    placement: Placement,
 }
 
 impl std::fmt::Debug for ObbtFile {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ObbtFile")
-            .field("info", &self.info())
+            .field("info", &self.meta.info)
             .finish()
     }
 }
@@ -211,61 +212,41 @@ impl ObbtFile {
         self.backing.bytes()
     }
 
-    /// The raw header.
-    pub fn header(&self) -> &Header {
-        &self.header
+    /// The raw header, as stored (a copy of the image's first 128 bytes; [`ObbtFile::info`]
+    /// has it decoded).
+    pub fn header(&self) -> Header {
+        // `open` checked that the image starts with a whole header: the zeros are never used.
+        Header::read_from_prefix(self.bytes())
+            .map(|(header, _)| header)
+            .unwrap_or_else(|_| Header::new_zeroed())
     }
 
     /// The decoded section directory.
     pub fn sections(&self) -> &[SectionInfo] {
-        &self.sections
+        &self.meta.info.sections
     }
 
     /// The volume type stored.
     pub fn bv_kind(&self) -> BvKind {
-        self.bv
+        self.meta.info.bv
     }
 
     /// The stored precision.
     pub fn precision(&self) -> Precision {
-        self.precision
+        self.meta.info.precision
     }
 
     /// How the stored coordinates were made from the input mesh's: `stored = scale · input +
     /// offset` ([`Placement::IDENTITY`] when the file has no `placement` section). Decoded on
     /// open, unverified: [`ObbtFile::verify`] checks that it is finite with a scale above 0.
     pub fn placement(&self) -> Placement {
-        self.placement
+        self.meta.info.placement
     }
 
     /// What the header says about the tree, with the placement decoded on open (reads no
     /// section).
     pub fn info(&self) -> Info {
-        let h = &self.header;
-        Info {
-            version: (h.version_major.get(), h.version_minor.get()),
-            bv: self.bv,
-            precision: self.precision,
-            fit: self.fit,
-            encoding: self.encoding,
-            leaf_size: u32::from(h.leaf_size.get()),
-            triangles: h.triangles.get(),
-            vertices: h.vertices.get(),
-            nodes: h.nodes.get(),
-            stats: TreeStats {
-                shape: TreeShape {
-                    leaves: h.leaves.get(),
-                    depth: h.depth.get(),
-                    max_leaf_faces: h.max_leaf_faces.get(),
-                },
-                degenerate_triangles: h.degenerate_triangles.get(),
-                bounds_min: h.bounds_min.map(|v| v.get()),
-                bounds_max: h.bounds_max.map(|v| v.get()),
-            },
-            placement: self.placement,
-            file_bytes: h.file_bytes.get(),
-            sections: self.sections.clone(),
-        }
+        self.meta.info.clone()
     }
 
     /// The O(n) checks of the spec: section checksums, zero padding, indices in bounds, a
@@ -283,9 +264,10 @@ impl ObbtFile {
 
     /// The tree typed as volume `B`; an error if the file stores another type or precision.
     pub fn view<B: BoundingVolume>(&self) -> Result<TreeView<'_, B>, FormatError> {
-        if B::KIND != self.bv || <B::Real as Real>::PRECISION != self.precision {
+        let (bv, precision) = (self.bv_kind(), self.precision());
+        if B::KIND != bv || <B::Real as Real>::PRECISION != precision {
             return Err(FormatError::WrongType {
-                found: format!("{} {}", self.bv.name(), self.precision.name()),
+                found: format!("{} {}", bv.name(), precision.name()),
                 requested: format!("{} {}", B::KIND.name(), <B::Real as Real>::PRECISION.name()),
             });
         }
@@ -297,7 +279,8 @@ impl ObbtFile {
         };
         let [vertices, faces, source_ids, nodes] = SectionKind::REQUIRED;
         let section = |k: usize, kind: SectionKind| {
-            self.required
+            self.meta
+                .required
                 .get(k)
                 .and_then(|range| bytes.get(range.clone()))
                 .ok_or_else(|| problem(k, kind, "out of bounds"))
@@ -310,7 +293,7 @@ impl ObbtFile {
             )
         };
         Ok(TreeView {
-            encoding: self.encoding,
+            encoding: self.meta.info.encoding,
             vertices: <[[B::Real; 3]]>::ref_from_bytes(section(0, vertices)?)
                 .map_err(|_| cast_err(0, vertices))?,
             faces: <[[u32; 3]]>::ref_from_bytes(section(1, faces)?)
@@ -324,7 +307,7 @@ impl ObbtFile {
 
     /// Runs `visitor` on the tree with its concrete volume type and precision.
     pub fn visit<V: TreeVisitor>(&self, visitor: V) -> Result<V::Output, FormatError> {
-        Ok(match (self.bv, self.precision) {
+        Ok(match (self.bv_kind(), self.precision()) {
             (BvKind::Obb, Precision::F32) => visitor.visit(self.view::<Obb<f32>>()?),
             (BvKind::Obb, Precision::F64) => visitor.visit(self.view::<Obb<f64>>()?),
             (BvKind::Aabb, Precision::F32) => visitor.visit(self.view::<Aabb<f32>>()?),
@@ -342,35 +325,14 @@ impl ObbtFile {
         if !bytes.as_ptr().addr().is_multiple_of(SECTION_ALIGN_BYTES) {
             return Err(FormatError::Misaligned);
         }
-        let checked = check_header(bytes)?;
-        Ok(ObbtFile {
-            backing,
-            header: checked.header,
-            sections: checked.sections,
-            required: checked.required,
-            bv: checked.bv,
-            precision: checked.precision,
-            encoding: checked.encoding,
-            fit: checked.fit,
-            placement: checked.placement,
-        })
+        let meta = check_header(bytes)?;
+        Ok(ObbtFile { backing, meta })
     }
-}
-
-struct Checked {
-    header: Header,
-    sections: Vec<SectionInfo>,
-    required: [Range<usize>; 4],
-    bv: BvKind,
-    precision: Precision,
-    encoding: Encoding,
-    fit: FitMethod,
-    placement: Placement,
 }
 
 /// The O(1) checks: signature, version, header CRC, declared length, tags and counts, and a
 /// directory whose sections are in bounds, aligned, disjoint and consistent with the header.
-fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
+fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
     let len = bytes.len() as u64;
     let at = Header::AT;
     let too_short = |needed: u64| FormatError::TooShort { len, needed };
@@ -588,14 +550,33 @@ fn check_header(bytes: &[u8]) -> Result<Checked, FormatError> {
             "a binary tree with one face per leaf has 2 x triangles - 1 nodes",
         ));
     }
-    Ok(Checked {
-        header,
-        sections,
-        required: ranges,
+    let stats = TreeStats {
+        shape: TreeShape {
+            leaves: header.leaves.get(),
+            depth: header.depth.get(),
+            max_leaf_faces: header.max_leaf_faces.get(),
+        },
+        degenerate_triangles: header.degenerate_triangles.get(),
+        bounds_min: header.bounds_min.map(|v| v.get()),
+        bounds_max: header.bounds_max.map(|v| v.get()),
+    };
+    let info = Info {
+        version: (major, minor),
         bv,
         precision,
-        encoding,
         fit,
+        encoding,
+        leaf_size,
+        triangles: header.triangles.get(),
+        vertices: header.vertices.get(),
+        nodes: header.nodes.get(),
+        stats,
         placement,
+        file_bytes: len,
+        sections,
+    };
+    Ok(Meta {
+        info,
+        required: ranges,
     })
 }
