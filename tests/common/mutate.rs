@@ -6,36 +6,13 @@
 //! Also [`exercise`]: open, query (unverified), verify, and when the damaged file verifies,
 //! compare its collision answer with a brute force over the file's own triangles.
 
-use obbtree::bv::pair::Transform;
 use obbtree::format::layout::{Field, Header, SectionEntry, ENTRY_SIZE, HEADER_SIZE};
 use obbtree::format::{AlignedBytes, ObbtFile};
+use obbtree::query::triangle::Triangle;
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
     DistanceOptions, Pose, QueryContext,
 };
-
-/// A seeded xorshift generator: the same seed gives the same mutations on every machine.
-pub struct Rng(u64);
-
-impl Rng {
-    /// A generator from a seed (any value).
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-
-    /// A number in `0..n` (`n > 0`).
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-}
 
 /// A library [`Field`] as (name, byte offset, width in bytes).
 const fn at(field: Field) -> (&'static str, usize, usize) {
@@ -307,31 +284,25 @@ pub fn exercise(bytes: &[u8], partner: &ObbtFile, poses: &Poses, check_answers: 
     outcome
 }
 
-/// Every contacting pair of two posed files by testing all pairs, B mapped into A's frame
-/// exactly as the queries map it; sorted input-mesh ids.
+/// Every contacting pair of two posed files by the brute-force oracle over the files' own
+/// triangles, B mapped into A's frame exactly as the queries map it; sorted input-mesh ids.
 pub fn brute_force_pairs(
     a: &ObbtFile,
     pose_a: &Pose,
     b: &ObbtFile,
     pose_b: &Pose,
 ) -> Vec<(u32, u32)> {
-    let xf: Transform = Pose::relative(pose_a, pose_b);
-    let to_vectors = |t: &[[f64; 3]; 3]| t.map(nalgebra::Vector3::from);
-    let ta: Vec<_> = super::file_triangles(a)
-        .iter()
-        .map(|(id, t)| (*id, to_vectors(t)))
-        .collect();
-    let tb: Vec<_> = super::file_triangles(b)
-        .iter()
-        .map(|(id, t)| (*id, to_vectors(t).map(|p| xf.apply(&p))))
-        .collect();
-    let mut pairs: Vec<(u32, u32)> = ta
-        .iter()
-        .flat_map(|(ia, a)| {
-            tb.iter().filter_map(move |(ib, b)| {
-                obbtree::query::triangle::triangles_intersect(a, b).then_some((*ia, *ib))
-            })
-        })
+    let split = |file: &ObbtFile| -> (Vec<u32>, Vec<Triangle>) {
+        super::file_triangles(file)
+            .into_iter()
+            .map(|(id, t)| (id, t.map(nalgebra::Vector3::from)))
+            .unzip()
+    };
+    let ((ids_a, ta), (ids_b, tb)) = (split(a), split(b));
+    let tb = super::oracle::in_frame_of_a(pose_a, pose_b, &tb);
+    let mut pairs: Vec<(u32, u32)> = super::oracle::contact_pairs(&ta, &tb)
+        .into_iter()
+        .map(|(i, j)| (ids_a[i as usize], ids_b[j as usize]))
         .collect();
     pairs.sort_unstable();
     pairs
