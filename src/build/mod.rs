@@ -8,7 +8,7 @@
 
 mod topdown;
 
-use crate::bv::{Aabb, BoundingVolume, BvKind, Obb, Sphere};
+use crate::bv::{with_volume_type, BoundingVolume, BvKind};
 use crate::fit::FitMethod;
 use crate::format::{self, ObbtFile, TreeImage, WriteError};
 use crate::mesh::TriMesh;
@@ -161,14 +161,7 @@ pub fn build(
     progress: Option<&AtomicU64>,
 ) -> Result<ObbtFile, BuildError> {
     options.validate()?;
-    match (options.bv, options.precision) {
-        (BvKind::Obb, Precision::F32) => build_as::<Obb<f32>>(mesh, options, progress),
-        (BvKind::Obb, Precision::F64) => build_as::<Obb<f64>>(mesh, options, progress),
-        (BvKind::Aabb, Precision::F32) => build_as::<Aabb<f32>>(mesh, options, progress),
-        (BvKind::Aabb, Precision::F64) => build_as::<Aabb<f64>>(mesh, options, progress),
-        (BvKind::Sphere, Precision::F32) => build_as::<Sphere<f32>>(mesh, options, progress),
-        (BvKind::Sphere, Precision::F64) => build_as::<Sphere<f64>>(mesh, options, progress),
-    }
+    with_volume_type!(options.bv, options.precision, B => build_as::<B>(mesh, options, progress))
 }
 
 fn build_as<B: BoundingVolume>(

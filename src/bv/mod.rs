@@ -20,6 +20,44 @@ use pair::Transform;
 use std::fmt::Debug;
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
+/// Evaluates `$body` with the type alias `$B` naming the stored volume type of a
+/// ([`BvKind`], [`crate::real::Precision`]) pair: the one place where the six combinations
+/// are spelt out (`$body` is expanded once for each). Adding a volume type means adding its
+/// two lines here, its [`BvKind`] and, for queries, its `ViewPair` variants.
+macro_rules! with_volume_type {
+    ($kind:expr, $precision:expr, $B:ident => $body:expr) => {{
+        use $crate::bv::BvKind as Kind;
+        use $crate::real::Precision as Scalar;
+        match ($kind, $precision) {
+            (Kind::Obb, Scalar::F32) => {
+                type $B = $crate::bv::Obb<f32>;
+                $body
+            }
+            (Kind::Obb, Scalar::F64) => {
+                type $B = $crate::bv::Obb<f64>;
+                $body
+            }
+            (Kind::Aabb, Scalar::F32) => {
+                type $B = $crate::bv::Aabb<f32>;
+                $body
+            }
+            (Kind::Aabb, Scalar::F64) => {
+                type $B = $crate::bv::Aabb<f64>;
+                $body
+            }
+            (Kind::Sphere, Scalar::F32) => {
+                type $B = $crate::bv::Sphere<f32>;
+                $body
+            }
+            (Kind::Sphere, Scalar::F64) => {
+                type $B = $crate::bv::Sphere<f64>;
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use with_volume_type;
+
 /// Which bounding volume a tree stores, as written in the file header.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BvKind {

@@ -7,7 +7,7 @@ use super::layout::{
     ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, PLACEMENT_STRIDE, SECTION_ALIGN,
     SIGNATURE, VERSION_MAJOR,
 };
-use crate::bv::{Aabb, BoundingVolume, BvKind, Node, Obb, Sphere};
+use crate::bv::{with_volume_type, BoundingVolume, BvKind, Node};
 use crate::fit::FitMethod;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
@@ -132,14 +132,7 @@ pub trait TreeVisitor {
 
 /// The stride of one node record of a given volume and precision (at most 128 bytes).
 fn node_size(bv: BvKind, precision: Precision) -> usize {
-    match (bv, precision) {
-        (BvKind::Obb, Precision::F32) => Node::<Obb<f32>>::SIZE,
-        (BvKind::Obb, Precision::F64) => Node::<Obb<f64>>::SIZE,
-        (BvKind::Aabb, Precision::F32) => Node::<Aabb<f32>>::SIZE,
-        (BvKind::Aabb, Precision::F64) => Node::<Aabb<f64>>::SIZE,
-        (BvKind::Sphere, Precision::F32) => Node::<Sphere<f32>>::SIZE,
-        (BvKind::Sphere, Precision::F64) => Node::<Sphere<f64>>::SIZE,
-    }
+    with_volume_type!(bv, precision, B => Node::<B>::SIZE)
 }
 
 /// [`SECTION_ALIGN`] as a `usize`, for checking a buffer's address.
@@ -307,14 +300,9 @@ impl ObbtFile {
 
     /// Runs `visitor` on the tree with its concrete volume type and precision.
     pub fn visit<V: TreeVisitor>(&self, visitor: V) -> Result<V::Output, FormatError> {
-        Ok(match (self.bv_kind(), self.precision()) {
-            (BvKind::Obb, Precision::F32) => visitor.visit(self.view::<Obb<f32>>()?),
-            (BvKind::Obb, Precision::F64) => visitor.visit(self.view::<Obb<f64>>()?),
-            (BvKind::Aabb, Precision::F32) => visitor.visit(self.view::<Aabb<f32>>()?),
-            (BvKind::Aabb, Precision::F64) => visitor.visit(self.view::<Aabb<f64>>()?),
-            (BvKind::Sphere, Precision::F32) => visitor.visit(self.view::<Sphere<f32>>()?),
-            (BvKind::Sphere, Precision::F64) => visitor.visit(self.view::<Sphere<f64>>()?),
-        })
+        Ok(with_volume_type!(self.bv_kind(), self.precision(), B => {
+            visitor.visit(self.view::<B>()?)
+        }))
     }
 
     fn from_backing(backing: Backing) -> Result<ObbtFile, FormatError> {
