@@ -5,7 +5,7 @@ use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
     BvKind,
 };
-use crate::arr3;
+use crate::arr3::{self, dot};
 use crate::real::{point_to_f64, Precision, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -127,7 +127,7 @@ impl<R: Real> Obb<R> {
             // Plain comparisons (not `f64::min`, which must also handle NaN): one
             // instruction each on the hottest loop of a build.
             for i in 0..3 {
-                let d = dot(&a[i], p);
+                let d = dot(a[i], *p);
                 lo[i] = if d < lo[i] { d } else { lo[i] };
                 hi[i] = if d > hi[i] { d } else { hi[i] };
             }
@@ -145,7 +145,7 @@ impl<R: Real> Obb<R> {
         let c = point_to_f64(&center);
         let slack = 2.0 * projection_slack(l1_max + l1(&c));
         let half = std::array::from_fn(|i| {
-            let d = dot(&a[i], &c);
+            let d = dot(a[i], c);
             R::from_f64_up((hi[i] - d).max(d - lo[i]).max(0.0) + slack)
         });
         Obb {
@@ -184,10 +184,6 @@ fn orthonormal_rows(axes: &Matrix3<f64>) -> Matrix3<f64> {
 /// Σh) by at most `3 tol Σh` along it; `4 tol` covers second-order terms.
 fn widen(h: Vector3<f64>, tol: f64) -> Vector3<f64> {
     h.add_scalar(4.0 * tol * h.sum())
-}
-
-pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Orthonormality tolerance of stored axes: rounding each component to f32 moves a dot
@@ -252,7 +248,7 @@ impl<R: Real> BoundingVolume for Obb<R> {
         for (i, ai) in a.iter().enumerate() {
             for (j, aj) in a.iter().enumerate() {
                 let expected = if i == j { 1.0 } else { 0.0 };
-                if (dot(ai, aj) - expected).abs() > tol {
+                if (dot(*ai, *aj) - expected).abs() > tol {
                     return Err(BvDefect::AxesNotOrthonormal);
                 }
             }
@@ -267,7 +263,7 @@ impl<R: Real> BoundingVolume for Obb<R> {
         let a = self.axes_f64();
         arr3::zip(a, h)
             .iter()
-            .all(|(axis, h)| dot(axis, &d).abs() <= h + tolerance)
+            .all(|(axis, h)| dot(*axis, d).abs() <= h + tolerance)
     }
 
     box_pair_methods!();

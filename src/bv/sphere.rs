@@ -1,12 +1,12 @@
 //! Bounding sphere.
 
-use super::obb::dot;
 use super::pair::Transform;
 use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, Aabb, BoundingVolume,
     BvDefect, BvKind,
 };
 use crate::arr3;
+use crate::arr3::dot;
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -42,7 +42,7 @@ impl<R: Real> Sphere<R> {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for p in points.clone() {
-            let d = [dot(&axes[0], p), dot(&axes[1], p), dot(&axes[2], p)];
+            let d = [dot(axes[0], *p), dot(axes[1], *p), dot(axes[2], *p)];
             lo = arr3::min(lo, d);
             hi = arr3::max(hi, d);
         }
@@ -65,7 +65,7 @@ impl<R: Real> Sphere<R> {
         let mut l1_max = 0.0f64;
         for p in points {
             let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-            r2 = r2.max(dot(&d, &d));
+            r2 = r2.max(dot(d, d));
             l1_max = l1_max.max(l1(p));
         }
         let slack = 2.0 * projection_slack(l1_max + l1(&c));
@@ -110,7 +110,7 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let c = point_to_f64(&self.center);
         let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-        dot(&d, &d).sqrt() <= self.radius.to_f64() + tolerance
+        dot(d, d).sqrt() <= self.radius.to_f64() + tolerance
     }
 
     #[inline]

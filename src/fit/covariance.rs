@@ -10,7 +10,7 @@
 //! covariance is translation invariant); that keeps the final `E[x xᵀ] − m mᵀ`
 //! subtraction free of catastrophic cancellation for data far from the origin.
 
-use super::vec3::{cross, norm2, V3};
+use crate::arr3::{cross, norm2, V3};
 
 /// A symmetric 3×3 matrix stored as `[xx, yy, zz, xy, xz, yz]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -32,11 +32,11 @@ impl Sym3 {
     #[inline]
     pub(crate) fn form(&self, a: V3, b: V3) -> f64 {
         let cb = [
-            super::vec3::dot(self.row(0), b),
-            super::vec3::dot(self.row(1), b),
-            super::vec3::dot(self.row(2), b),
+            crate::arr3::dot(self.row(0), b),
+            crate::arr3::dot(self.row(1), b),
+            crate::arr3::dot(self.row(2), b),
         ];
-        super::vec3::dot(a, cb)
+        crate::arr3::dot(a, cb)
     }
 
     /// True when every entry is finite.

@@ -6,7 +6,7 @@
 //! tolerance is relative and the test is invariant to scale. The same simplex seeds the
 //! 3-D convex hull, which is why it is kept.
 
-use super::vec3::{cross, dot, norm2, normalize, sub, V3};
+use crate::arr3::{cross, dot, norm2, normalize, sub, V3};
 
 /// Extents below this fraction of the diameter count as zero when deciding dimension.
 pub(crate) const DIMENSION_TOLERANCE: f64 = 1e-12;

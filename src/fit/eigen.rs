@@ -9,9 +9,9 @@ use nalgebra::{Matrix3, SymmetricEigen};
 
 use super::covariance::Sym3;
 use super::frame::{in_plane_axis, Frame};
-use super::vec3::{cross, norm2, normalize, V3};
+use crate::arr3::{cross, norm2, normalize, V3};
 #[cfg(test)]
-use super::vec3::{scale, sub};
+use crate::arr3::{scale, sub};
 
 /// Eigenvalues closer than this fraction of the largest one count as equal.
 pub(crate) const TIE_TOLERANCE: f64 = 1e-9;
@@ -191,7 +191,7 @@ pub(crate) fn axes2(a: f64, b: f64, c: f64, u: V3, v: V3, normal: V3) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::vec3::dot;
+    use crate::arr3::dot;
 
     /// SplitMix64, for reproducible random matrices.
     fn rng(state: &mut u64) -> f64 {

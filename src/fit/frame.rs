@@ -8,7 +8,7 @@
 
 use nalgebra::Matrix3;
 
-use super::vec3::{axis, cross, dot, norm2, normalize, scale, sub, V3};
+use crate::arr3::{axis, cross, dot, norm2, normalize, scale, sub, V3};
 
 /// Principal directions, sorted by decreasing spread, with possibly free columns.
 #[derive(Clone, Copy, Debug, PartialEq)]

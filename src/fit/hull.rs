@@ -10,8 +10,8 @@ use std::fmt;
 use super::dimension::{classify, Shape, DIMENSION_TOLERANCE};
 use super::polygon::convex_polygon;
 use super::quickhull::QuickHull;
-use super::vec3::{cross, dot, norm2, sub, V3};
 use crate::arr3;
+use crate::arr3::{cross, dot, norm2, sub, V3};
 
 /// Relative plane tolerance of the hull, as a fraction of the point set's diameter
 /// (bounding-box diagonal).

@@ -5,7 +5,7 @@
 //! later, by the caller, over all vertices along these axes, so the frame only decides
 //! how tight the box is, never whether it contains the geometry.
 //!
-//! The pieces, one concept per file: `vec3` (arithmetic), `scratch` (per-thread buffers,
+//! The pieces, one concept per file (3-vector arithmetic is `crate::arr3`): `scratch` (per-thread buffers,
 //! distinct vertices), `dimension` (intrinsic dimension, §3.3.5), `covariance` (moments,
 //! §3.3–3.4), [`hull`] with `quickhull` and `polygon` (convex hulls), `eigen` (sorted
 //! eigen-decomposition, ties), `frame` (deterministic completion, signs, handedness),
@@ -33,7 +33,6 @@ mod quickhull;
 mod scratch;
 mod symmetry;
 mod triangle;
-mod vec3;
 
 /// Which covariance the OBB frame is computed from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

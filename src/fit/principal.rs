@@ -15,8 +15,8 @@ use super::frame::{finish, Frame};
 use super::hull::{is_flat, plane_basis};
 use super::scratch::Scratch;
 use super::symmetry::{refine, LargestTriangles};
-use super::vec3::{sub, V3};
 use super::FitMethod;
+use crate::arr3::{sub, V3};
 
 /// Where the covariance came from; the same triangles propose axes for tied eigenvalues.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -17,7 +17,7 @@
 //! Nothing here panics or loops: each iteration consumes one outside point for good, so
 //! the loop ends after at most as many iterations as there are points.
 
-use super::vec3::{cross, dot, norm2, sub, V3};
+use crate::arr3::{cross, dot, norm2, sub, V3};
 
 /// Marks an absent point or face.
 const NONE: u32 = u32::MAX;

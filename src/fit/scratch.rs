@@ -6,8 +6,8 @@
 
 use super::dimension::Extremes;
 use super::hull::HullScratch;
-use super::vec3::V3;
 use crate::arr3;
+use crate::arr3::V3;
 
 /// Buffers reused across fits on one thread.
 #[derive(Debug, Default)]

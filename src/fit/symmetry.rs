@@ -13,7 +13,7 @@
 //! matter for speed.
 
 use super::frame::Frame;
-use super::vec3::{cross, dot, norm2, normalize, scale, sub, V3};
+use crate::arr3::{cross, dot, norm2, normalize, scale, sub, V3};
 
 /// How many of the largest triangles propose directions.
 const CANDIDATES: usize = 4;

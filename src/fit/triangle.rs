@@ -13,8 +13,8 @@ use super::dimension::{DIMENSION_TOLERANCE, POINT_TOLERANCE};
 use super::eigen::axes2;
 use super::frame::{finish, Frame};
 use super::symmetry::{refine, LargestTriangles};
-use super::vec3::{cross, dot, norm2, normalize, sub, V3};
 use crate::arr3;
+use crate::arr3::{cross, dot, norm2, normalize, sub, V3};
 
 /// The principal-axes frame of triangle `(p, q, r)`, by the same rules as the general fit.
 pub(crate) fn triangle_frame(p: V3, q: V3, r: V3) -> Matrix3<f64> {
