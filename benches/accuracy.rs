@@ -27,7 +27,7 @@ mod parry_support;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{Matrix3, Vector3};
-use obbtree::build::{build, BuildOptions};
+use obbtree::build::{build, BuildOptions, DEFAULT_HULL_MIN_FACES};
 use obbtree::bv::pair::SAT_GUARD;
 use obbtree::fit::FitMethod;
 use obbtree::format::ObbtFile;
@@ -47,6 +47,8 @@ struct Config {
     name: &'static str,
     precision: Precision,
     fit: FitMethod,
+    /// `BuildOptions::hull_min_faces`.
+    hull_min_faces: u32,
     guard: f64,
     rel_err: f64,
 }
@@ -55,11 +57,12 @@ const BASELINE: Config = Config {
     name: "baseline",
     precision: Precision::F64,
     fit: FitMethod::Hull,
+    hull_min_faces: DEFAULT_HULL_MIN_FACES,
     guard: SAT_GUARD,
     rel_err: 0.0,
 };
 
-const CONFIGS: [Config; 7] = [
+const CONFIGS: [Config; 8] = [
     BASELINE,
     Config {
         name: "f32",
@@ -82,6 +85,11 @@ const CONFIGS: [Config; 7] = [
         ..BASELINE
     },
     Config {
+        name: "fit-hull-everywhere",
+        hull_min_faces: 1,
+        ..BASELINE
+    },
+    Config {
         name: "fit-triangles",
         fit: FitMethod::Triangles,
         ..BASELINE
@@ -98,13 +106,17 @@ impl Config {
         BuildOptions {
             precision: self.precision,
             fit: self.fit,
+            hull_min_faces: self.hull_min_faces,
             ..BuildOptions::default()
         }
     }
 
     /// Whether this configuration changes the file (and so has its own build timing).
     fn changes_the_file(&self) -> bool {
-        self.precision != BASELINE.precision || self.fit != BASELINE.fit || self.name == "baseline"
+        self.precision != BASELINE.precision
+            || self.fit != BASELINE.fit
+            || self.hull_min_faces != BASELINE.hull_min_faces
+            || self.name == "baseline"
     }
 }
 
