@@ -89,6 +89,7 @@ pub mod fit;
 pub mod format;
 pub mod mesh;
 pub mod placement;
+mod pose;
 pub mod query;
 pub mod real;
 pub mod scene;

@@ -22,11 +22,11 @@ mod descent;
 mod distance;
 mod engine;
 mod pair_query;
-mod pose;
 mod span;
 mod stats;
 pub mod triangle;
 
+pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
 pub use collide::{collide, collide_files, collide_into, CollideOptions, CollideResult};
 pub use descent::DescentRule;
 pub use distance::{
@@ -35,7 +35,6 @@ pub use distance::{
 };
 pub use engine::QueryContext;
 pub use pair_query::PairQuery;
-pub use pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
 pub use span::{span, span_files, SpanResult};
 pub use stats::Stats;
 
