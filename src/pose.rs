@@ -1,13 +1,25 @@
-//! Poses of models in the world, and their validation.
+//! Poses: of models in the world, and of one model in another's frame; their number
+//! formats and validation.
 
-use crate::bv::pair::Transform;
 use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// Largest deviation of `RᵀR` from the identity accepted for a rotation.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-6;
 
-/// Where a model is: world point = `rotation * p + translation` for a model point `p`.
-/// Always f64, whatever the stored precision of the tree.
+/// A rigid motion placing one frame in another: a point `p` of the placed frame is
+/// `rotation * p + translation` in the other. Always f64, whatever the stored precision of
+/// the trees.
+///
+/// A model's pose places its model frame in the world (translation in world units). The
+/// relative pose of a pair, [`Pose::relative`], places model B's frame in model A's
+/// (translation in A's model units): queries compute it once and the volume tests of
+/// [`crate::bv`] take it, named `b_to_a` for what it maps.
+///
+/// The rotation is orthonormal with determinant +1, within [`ORTHONORMAL_TOLERANCE`]:
+/// [`Pose::new`] and the constructors built on it check that, and that every number is
+/// finite; [`Pose::identity`] and [`Pose::translation`] have the identity rotation (the
+/// latter takes its numbers as given). A relative pose, composed of two such poses, is not
+/// checked again: its rotation is orthonormal within a few times the tolerance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pose {
     rotation: Matrix3<f64>,
@@ -303,25 +315,32 @@ impl Pose {
     }
 
     /// The rotation.
+    #[inline]
     pub fn rotation(&self) -> &Matrix3<f64> {
         &self.rotation
     }
 
-    /// The translation, world units.
+    /// The translation, in the units of the frame the pose places into (world units for a
+    /// model's pose, A's model units for [`Pose::relative`]).
+    #[inline]
     pub fn translation_vector(&self) -> &Vector3<f64> {
         &self.translation
     }
 
-    /// Maps a model point to the world.
+    /// Maps a point of the placed frame into the other (a model point to the world, for a
+    /// model's pose).
+    #[inline]
     pub fn apply(&self, p: &Vector3<f64>) -> Vector3<f64> {
         self.rotation * p + self.translation
     }
 
-    /// The map from model B's frame (posed by `b`) into model A's frame (posed by `a`):
-    /// `p_a = Raᵀ (Rb p_b + Tb − Ta)`. Queries compute it once and then work in A's frame.
-    pub fn relative(a: &Pose, b: &Pose) -> Transform {
+    /// The pose of model B's frame in model A's, given their poses in the world: it maps
+    /// `p_b` to `p_a = Raᵀ (Rb p_b + Tb − Ta)`. Queries compute it once and then work in
+    /// A's frame (dissertation §2.3.3). Not validated again: its rotation is the product
+    /// of two checked ones.
+    pub fn relative(a: &Pose, b: &Pose) -> Pose {
         let rt = a.rotation.transpose();
-        Transform {
+        Pose {
             rotation: rt * b.rotation,
             translation: rt * (b.translation - a.translation),
         }

@@ -5,9 +5,10 @@ mod common;
 
 use common::oracle;
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use obbtree::bv::pair::{BoxPair, Transform, SAT_GUARD};
+use obbtree::bv::pair::{BoxPair, SAT_GUARD};
 use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
 use obbtree::query::triangle::Triangle;
+use obbtree::query::Pose;
 use proptest::prelude::*;
 
 fn rotation(ax: f64, ay: f64, az: f64) -> Matrix3<f64> {
@@ -86,7 +87,7 @@ fn arb_box() -> impl Strategy<Value = Obb<f64>> {
         })
 }
 
-fn arb_transform() -> impl Strategy<Value = Transform> {
+fn arb_relative_pose() -> impl Strategy<Value = Pose> {
     (
         -3.0..3.0f64,
         -3.0..3.0f64,
@@ -95,15 +96,12 @@ fn arb_transform() -> impl Strategy<Value = Transform> {
         -2.0..2.0f64,
         -2.0..2.0f64,
     )
-        .prop_map(|(a, b, c, x, y, z)| Transform {
-            rotation: rotation(a, b, c),
-            translation: Vector3::new(x, y, z),
-        })
+        .prop_map(|(a, b, c, x, y, z)| Pose::new(rotation(a, b, c), Vector3::new(x, y, z)).unwrap())
 }
 
-/// The 12 face triangles of a box, mapped by `xf`.
-fn surface(o: &Obb<f64>, xf: &Transform) -> Vec<Triangle> {
-    let c: Vec<Vector3<f64>> = corners(o).iter().map(|p| xf.apply(p)).collect();
+/// The 12 face triangles of a box, mapped by `pose`.
+fn surface(o: &Obb<f64>, pose: &Pose) -> Vec<Triangle> {
+    let c: Vec<Vector3<f64>> = corners(o).iter().map(|p| pose.apply(p)).collect();
     // Corner k has bit i set when it lies on the + side of axis i (see `corners`).
     let mut out = Vec::new();
     for axis in 0..3 {
@@ -118,19 +116,19 @@ fn surface(o: &Obb<f64>, xf: &Transform) -> Vec<Triangle> {
     out
 }
 
-/// The exact distance between the surfaces of two boxes (B mapped by `xf`). For boxes
+/// The exact distance between the surfaces of two boxes (B mapped by `b_to_a`). For boxes
 /// that do not overlap this is the box distance.
-fn surface_distance(a: &Obb<f64>, b: &Obb<f64>, xf: &Transform) -> f64 {
-    oracle::min_distance(&surface(a, &Transform::identity()), &surface(b, xf))
+fn surface_distance(a: &Obb<f64>, b: &Obb<f64>, b_to_a: &Pose) -> f64 {
+    oracle::min_distance(&surface(a, &Pose::identity()), &surface(b, b_to_a))
 }
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
 
     #[test]
-    fn box_max_distance_is_the_corner_maximum(a in arb_box(), b in arb_box(), xf in arb_transform()) {
-        let brute = oracle::max_distance(&surface(&a, &Transform::identity()), &surface(&b, &xf));
-        let fast = a.max_distance_upper_bound(&b, &xf);
+    fn box_max_distance_is_the_corner_maximum(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
+        let brute = oracle::max_distance(&surface(&a, &Pose::identity()), &surface(&b, &b_to_a));
+        let fast = a.max_distance_upper_bound(&b, &b_to_a);
         // An upper bound, above the corner maximum by at most the slack of f64 frames
         // (1e-10 x half-widths and offset) and rounding.
         prop_assert!(fast >= brute * (1.0 - 1e-15), "fast {fast} < brute {brute}");
@@ -138,15 +136,15 @@ proptest! {
     }
 
     #[test]
-    fn box_lower_bound_never_exceeds_a_point_pair_distance(a in arb_box(), b in arb_box(), xf in arb_transform()) {
-        let lb = a.distance_lower_bound(&b, &xf);
+    fn box_lower_bound_never_exceeds_a_point_pair_distance(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
+        let lb = a.distance_lower_bound(&b, &b_to_a);
         let pa = grid_points(&a, 4);
-        let pb: Vec<_> = grid_points(&b, 4).iter().map(|q| xf.apply(q)).collect();
+        let pb: Vec<_> = grid_points(&b, 4).iter().map(|q| b_to_a.apply(q)).collect();
         let sampled = pa.iter().flat_map(|p| pb.iter().map(move |q| (p - q).norm())).fold(f64::INFINITY, f64::min);
         prop_assert!(lb <= sampled + 1e-12, "lower bound {lb} > sampled {sampled}");
         // A positive bound means the boxes are disjoint, which the overlap test must not contradict
         // beyond its guard, and an overlap verdict of "disjoint" needs separation.
-        if !a.overlaps(&b, &xf, SAT_GUARD) {
+        if !a.overlaps(&b, &b_to_a, SAT_GUARD) {
             prop_assert!(sampled > 0.0);
         }
     }
@@ -155,35 +153,35 @@ proptest! {
     /// any pair of separated boxes (the face-axis gaps alone reach only 1/√3 of it for
     /// boxes diagonal to each other, and nothing like it for thin boxes far apart).
     #[test]
-    fn box_lower_bound_is_at_least_three_quarters_of_the_box_distance(a in arb_box(), b in arb_box(), xf in arb_transform()) {
-        let lb = a.distance_lower_bound(&b, &xf);
-        let d = surface_distance(&a, &b, &xf);
+    fn box_lower_bound_is_at_least_three_quarters_of_the_box_distance(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
+        let lb = a.distance_lower_bound(&b, &b_to_a);
+        let d = surface_distance(&a, &b, &b_to_a);
         prop_assert!(lb <= d + 1e-9, "lower bound {lb} above the surface distance {d}");
         // (Below about 1e-4 the guard's slack, 1e-6 of the boxes' size, takes its share.)
-        if d > 1e-3 && !a.overlaps(&b, &xf, 0.0) {
+        if d > 1e-3 && !a.overlaps(&b, &b_to_a, 0.0) {
             prop_assert!(lb >= 0.75 * d, "lower bound {lb} below 3/4 of the distance {d}");
         }
     }
 
     #[test]
-    fn overlap_is_never_missed(a in arb_box(), b in arb_box(), xf in arb_transform()) {
+    fn overlap_is_never_missed(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
         // If some point of B lies inside A, the boxes overlap and the test must say so.
-        let inside = grid_points(&b, 5).iter().any(|q| a.contains(xf.apply(q).into(), 1e-12));
+        let inside = grid_points(&b, 5).iter().any(|q| a.contains(b_to_a.apply(q).into(), 1e-12));
         if inside {
-            prop_assert!(a.overlaps(&b, &xf, SAT_GUARD));
-            prop_assert!(a.overlaps(&b, &xf, 0.0));
-            prop_assert_eq!(a.distance_lower_bound(&b, &xf), 0.0);
+            prop_assert!(a.overlaps(&b, &b_to_a, SAT_GUARD));
+            prop_assert!(a.overlaps(&b, &b_to_a, 0.0));
+            prop_assert_eq!(a.distance_lower_bound(&b, &b_to_a), 0.0);
         }
     }
 
     #[test]
-    fn spheres_and_aabbs_agree_with_points(c1 in prop::array::uniform3(-2.0..2.0f64), c2 in prop::array::uniform3(-2.0..2.0f64), r1 in 0.0..1.5f64, r2 in 0.0..1.5f64, xf in arb_transform()) {
+    fn spheres_and_aabbs_agree_with_points(c1 in prop::array::uniform3(-2.0..2.0f64), c2 in prop::array::uniform3(-2.0..2.0f64), r1 in 0.0..1.5f64, r2 in 0.0..1.5f64, b_to_a in arb_relative_pose()) {
         let s1 = Sphere { center: c1, radius: r1 };
         let s2 = Sphere { center: c2, radius: r2 };
-        let d = (Vector3::from(c1) - xf.apply(&Vector3::from(c2))).norm();
-        prop_assert_eq!(s1.overlaps(&s2, &xf, 0.0), d <= r1 + r2);
-        prop_assert!((s1.distance_lower_bound(&s2, &xf) - (d - r1 - r2).max(0.0)).abs() < 1e-12);
-        prop_assert!((s1.max_distance_upper_bound(&s2, &xf) - (d + r1 + r2)).abs() < 1e-12);
+        let d = (Vector3::from(c1) - b_to_a.apply(&Vector3::from(c2))).norm();
+        prop_assert_eq!(s1.overlaps(&s2, &b_to_a, 0.0), d <= r1 + r2);
+        prop_assert!((s1.distance_lower_bound(&s2, &b_to_a) - (d - r1 - r2).max(0.0)).abs() < 1e-12);
+        prop_assert!((s1.max_distance_upper_bound(&s2, &b_to_a) - (d + r1 + r2)).abs() < 1e-12);
         let lo1 = [c1[0] - r1, c1[1] - r1, c1[2] - r1];
         let hi1 = [c1[0] + r1, c1[1] + r1, c1[2] + r1];
         let lo2 = [c2[0] - r2, c2[1] - r2, c2[2] - r2];
@@ -192,8 +190,8 @@ proptest! {
         let a2 = Aabb { min: lo2, max: hi2 };
         let o1 = obb(Matrix3::identity(), Vector3::from(c1), Vector3::repeat(r1));
         let o2 = obb(Matrix3::identity(), Vector3::from(c2), Vector3::repeat(r2));
-        prop_assert_eq!(a1.overlaps(&a2, &xf, SAT_GUARD), o1.overlaps(&o2, &xf, SAT_GUARD));
-        prop_assert!((a1.max_distance_upper_bound(&a2, &xf) - o1.max_distance_upper_bound(&o2, &xf)).abs() < 2e-8);
+        prop_assert_eq!(a1.overlaps(&a2, &b_to_a, SAT_GUARD), o1.overlaps(&o2, &b_to_a, SAT_GUARD));
+        prop_assert!((a1.max_distance_upper_bound(&a2, &b_to_a) - o1.max_distance_upper_bound(&o2, &b_to_a)).abs() < 2e-8);
     }
 }
 
@@ -209,18 +207,15 @@ fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
         Vector3::zeros(),
         Vector3::new(0.5, 0.5, 0.5),
     );
-    let xf = Transform {
-        rotation: Matrix3::identity(),
-        translation: Vector3::new(3.0, 0.0, 0.0),
-    };
-    assert!(!a.overlaps(&b, &xf, SAT_GUARD));
+    let b_to_a = Pose::translation(3.0, 0.0, 0.0);
+    assert!(!a.overlaps(&b, &b_to_a, SAT_GUARD));
     // The exact gap, less the guard's slack of 1e-6 x the half-widths (4.5e-6) and the f64
     // frames' 4e-10 x the offset.
-    let lb = a.distance_lower_bound(&b, &xf);
+    let lb = a.distance_lower_bound(&b, &b_to_a);
     assert!((1.5 - 5e-6..=1.5).contains(&lb), "{lb}");
     // Farthest corners: (-1, ±1, ±1) and (3.5, ∓0.5, ∓0.5).
     let expected = (4.5f64 * 4.5 + 1.5 * 1.5 + 1.5 * 1.5).sqrt();
-    let ub = a.max_distance_upper_bound(&b, &xf);
+    let ub = a.max_distance_upper_bound(&b, &b_to_a);
     assert!(
         (expected..expected + 2e-9).contains(&ub),
         "{ub} vs {expected}"
@@ -232,7 +227,7 @@ fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
         &Matrix3::identity(),
         &Vector3::zeros(),
         Vector3::repeat(0.5),
-        &xf,
+        &b_to_a,
         0.0,
     );
     assert!(pair.disjoint(0.0));
@@ -248,12 +243,9 @@ fn far_apart_boxes_along_a_diagonal_have_a_tight_lower_bound() {
     let a = obb(Matrix3::identity(), Vector3::zeros(), unit);
     let b = obb(rotation(0.3, -0.2, 0.5), Vector3::zeros(), unit);
     for far in [1.0, 10.0, 1e3, 1e300] {
-        let xf = Transform {
-            rotation: Matrix3::identity(),
-            translation: Vector3::repeat(far),
-        };
+        let b_to_a = Pose::translation(far, far, far);
         let centres = 3f64.sqrt() * far;
-        let lb = a.distance_lower_bound(&b, &xf);
+        let lb = a.distance_lower_bound(&b, &b_to_a);
         // Each box lies within 0.01·√3 of its centre.
         let slack = 2.0 * 0.01 * 3f64.sqrt();
         // Up to the rounding of the centres' distance itself.
@@ -288,15 +280,12 @@ fn f32_boxes_far_apart_keep_a_tight_lower_bound() {
     let (a32, b32) = (to_f32(a64), to_f32(b64));
     for far in [1e3, 1e6, 1e9, 1e12] {
         for direction in [Vector3::x(), Vector3::new(1.0, 1.0, 1.0).normalize()] {
-            let xf = Transform {
-                rotation: rotation(0.1, 0.2, 0.3),
-                translation: direction * far,
-            };
+            let b_to_a = Pose::new(rotation(0.1, 0.2, 0.3), direction * far).unwrap();
             // Each box lies within its circumradius of its centre (which is at the origin).
             let reach = 2.0 * half.norm() * (1.0 + 1e-5);
             for lb in [
-                a64.distance_lower_bound(&b64, &xf),
-                a32.distance_lower_bound(&b32, &xf),
+                a64.distance_lower_bound(&b64, &b_to_a),
+                a32.distance_lower_bound(&b32, &b_to_a),
             ] {
                 assert!(lb <= far, "{far}: {lb} exceeds the centre distance");
                 assert!(
@@ -321,10 +310,7 @@ fn thin_boxes_far_apart_are_bounded_along_the_centre_line() {
         let a = obb(rotation(0.7, -0.4, 1.1 + k as f64), Vector3::zeros(), half);
         let b = obb(rotation(-0.2, 0.9, 0.3), Vector3::zeros(), half);
         let direction = Vector3::new(1.0, -2.0, 0.5).normalize();
-        let xf = Transform {
-            rotation: Matrix3::identity(),
-            translation: direction * far,
-        };
+        let b_to_a = Pose::new(Matrix3::identity(), direction * far).unwrap();
         // Support radii of the two flat boxes along the line.
         let support = |o: &Obb<f64>| {
             o.axes
@@ -334,7 +320,7 @@ fn thin_boxes_far_apart_are_bounded_along_the_centre_line() {
                 .sum::<f64>()
         };
         let gap = far - support(&a) - support(&b);
-        let lb = a.distance_lower_bound(&b, &xf);
+        let lb = a.distance_lower_bound(&b, &b_to_a);
         // The true distance exceeds the gap by at most how far the boxes bulge across the
         // line: (circumradius sum)^2 / far; no lower bound may exceed it.
         let bulge = (2.0 * half.norm()).powi(2) / far;

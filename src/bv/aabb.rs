@@ -1,8 +1,9 @@
 //! Axis-aligned bounding box in the model frame.
 
-use super::pair::{box_pair_methods, BoxPair, PairSetup, Transform};
+use super::pair::{box_pair_methods, BoxPair, PairSetup};
 use super::{all_finite, face_vertices, listed_vertices, BoundingVolume, BvDefect, BvKind};
 use crate::arr3;
+use crate::pose::Pose;
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -40,11 +41,11 @@ impl<R: Real> Aabb<R> {
     }
 
     #[inline]
-    fn pair_with(&self, other: &Self, xf: &Transform, _setup: PairSetup) -> BoxPair {
+    fn pair_with(&self, other: &Self, b_to_a: &Pose, _setup: PairSetup) -> BoxPair {
         let (ca, ha) = self.center_half();
         let (cb, hb) = other.center_half();
         let identity = Matrix3::identity();
-        BoxPair::new(&identity, &ca, ha, &identity, &cb, hb, xf, 0.0)
+        BoxPair::new(&identity, &ca, ha, &identity, &cb, hb, b_to_a, 0.0)
     }
 
     fn half_f64(&self) -> [f64; 3] {

@@ -14,9 +14,9 @@ pub use aabb::Aabb;
 pub use obb::Obb;
 pub use sphere::Sphere;
 
+use crate::pose::Pose;
 use crate::real::Real;
 use nalgebra::{Matrix3, Vector3};
-use pair::Transform;
 use std::fmt::Debug;
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
@@ -161,16 +161,17 @@ pub trait BoundingVolume:
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool;
 
     /// Whether this volume (model A's frame) and `other` (model B's frame, mapped into A's by
-    /// `xf`) may intersect. Conservative: `false` only if they are certainly disjoint. `guard`
-    /// is the separating-axis guard of §4.5 ([`pair::SAT_GUARD`]; boxes only).
-    fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool;
+    /// `b_to_a`, the pose of B's frame in A's: [`Pose::relative`]) may intersect.
+    /// Conservative: `false` only if they are certainly disjoint. `guard` is the
+    /// separating-axis guard of §4.5 ([`pair::SAT_GUARD`]; boxes only).
+    fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool;
 
     /// A lower bound on the distance between this volume and `other` (posed as in
     /// [`BoundingVolume::overlaps`]); 0 when they may overlap. The tightest this volume
     /// type gives: [`BoundingVolume::distance_lower_bound_until`] with no threshold.
     #[inline]
-    fn distance_lower_bound(&self, other: &Self, xf: &Transform) -> f64 {
-        self.distance_lower_bound_until(other, xf, f64::INFINITY)
+    fn distance_lower_bound(&self, other: &Self, b_to_a: &Pose) -> f64 {
+        self.distance_lower_bound_until(other, b_to_a, f64::INFINITY)
     }
 
     /// A lower bound on the distance, as [`BoundingVolume::distance_lower_bound`], whose
@@ -178,11 +179,11 @@ pub trait BoundingVolume:
     /// bound reaches a threshold needs no tighter bound for those, and most pairs it tests
     /// are pruned by the cheapest terms. The result is either `>= enough` or the tightest
     /// bound.
-    fn distance_lower_bound_until(&self, other: &Self, xf: &Transform, enough: f64) -> f64;
+    fn distance_lower_bound_until(&self, other: &Self, b_to_a: &Pose, enough: f64) -> f64;
 
     /// An upper bound on the largest distance between a point of this volume and a point of
     /// `other` (posed as in [`BoundingVolume::overlaps`]).
-    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64;
+    fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64;
 
     /// An axis-aligned box containing this volume once mapped by `p ↦ rotation · p +
     /// translation` (a model pose): the broad phase of scenes bounds each posed model by

@@ -1,11 +1,12 @@
 //! Oriented bounding box (dissertation §3.2).
 
-use super::pair::{box_pair_methods, BoxPair, PairSetup, Transform, SAT_GUARD};
+use super::pair::{box_pair_methods, BoxPair, PairSetup, SAT_GUARD};
 use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
     BvKind,
 };
 use crate::arr3::{self, dot};
+use crate::pose::Pose;
 use crate::real::{point_to_f64, Precision, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -56,7 +57,7 @@ impl<R: Real> Obb<R> {
     /// bound, so the metric setup then (past [`FAR`]) re-orthonormalises both frames in f64
     /// and widens the half-widths to cover the move, leaving only rounding in the slack.
     #[inline]
-    fn pair_with(&self, other: &Self, xf: &Transform, setup: PairSetup) -> BoxPair {
+    fn pair_with(&self, other: &Self, b_to_a: &Pose, setup: PairSetup) -> BoxPair {
         let tol = axis_tolerance(R::PRECISION);
         let ca = Vector3::from(self.center_f64());
         let cb = Vector3::from(other.center_f64());
@@ -64,7 +65,7 @@ impl<R: Real> Obb<R> {
             Vector3::from(self.half_f64()),
             Vector3::from(other.half_f64()),
         );
-        let offset = xf.apply(&cb) - ca;
+        let offset = b_to_a.apply(&cb) - ca;
         let (axes_a, axes_b) = (self.axes_matrix(), other.axes_matrix());
         // (Overlap tests never re-orthonormalise: the frame term is only worked out for
         // distance bounds.)
@@ -77,11 +78,11 @@ impl<R: Real> Obb<R> {
                 &orthonormal_rows(&axes_b),
                 widen(hb, tol),
                 &offset,
-                &xf.rotation,
+                b_to_a.rotation(),
                 0.0,
             );
         }
-        BoxPair::from_offset(&axes_a, ha, &axes_b, hb, &offset, &xf.rotation, tol)
+        BoxPair::from_offset(&axes_a, ha, &axes_b, hb, &offset, b_to_a.rotation(), tol)
     }
 
     /// Centre, axes (rows), half-widths and the frame's orthonormality tolerance, in f64.

@@ -2,33 +2,8 @@
 //! an upper bound on their largest distance. Everything is in f64 in the frame of box A
 //! (or of model A for spheres), whatever the stored precision.
 
+use crate::pose::Pose;
 use nalgebra::{Matrix3, Vector3};
-
-/// Maps model B's frame into model A's: `p_a = rotation * p_b + translation`. Computed once
-/// per query from the two poses (dissertation §2.3.3).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Transform {
-    /// Rotation part (orthonormal).
-    pub rotation: Matrix3<f64>,
-    /// Translation part, model units of A.
-    pub translation: Vector3<f64>,
-}
-
-impl Transform {
-    /// The identity.
-    pub fn identity() -> Transform {
-        Transform {
-            rotation: Matrix3::identity(),
-            translation: Vector3::zeros(),
-        }
-    }
-
-    /// Applies the transform to a point.
-    #[inline]
-    pub fn apply(&self, p: &Vector3<f64>) -> Vector3<f64> {
-        self.rotation * p + self.translation
-    }
-}
 
 /// The guard added to every `|R_ij|` in the separating-axis test (dissertation §4.5): when
 /// two box edges are nearly parallel their cross product is nearly zero and rounding alone
@@ -80,15 +55,23 @@ impl BoxPair {
         b_axes: &Matrix3<f64>,
         cb: &Vector3<f64>,
         hb: Vector3<f64>,
-        xf: &Transform,
+        b_to_a: &Pose,
         frame_error: f64,
     ) -> BoxPair {
-        let offset = xf.apply(cb) - ca;
-        BoxPair::from_offset(a_axes, ha, b_axes, hb, &offset, &xf.rotation, frame_error)
+        let offset = b_to_a.apply(cb) - ca;
+        BoxPair::from_offset(
+            a_axes,
+            ha,
+            b_axes,
+            hb,
+            &offset,
+            b_to_a.rotation(),
+            frame_error,
+        )
     }
 
-    /// As [`BoxPair::new`], given the centre offset `offset = xf(cb) − ca` (model A's
-    /// frame) and the rotation of `xf`.
+    /// As [`BoxPair::new`], given the centre offset `offset = b_to_a(cb) − ca` (model A's
+    /// frame) and the rotation of `b_to_a`.
     #[inline]
     pub fn from_offset(
         a_axes: &Matrix3<f64>,
@@ -349,27 +332,27 @@ pub(crate) enum PairSetup {
 }
 
 /// The pair tests and size measures shared by the two box volumes, written once: both types
-/// provide `pair_with(&self, &Self, &Transform, PairSetup) -> BoxPair`,
+/// provide `pair_with(&self, &Self, &Pose, PairSetup) -> BoxPair`,
 /// `half_f64(&self) -> [f64; 3]` and `local_box(&self)` (centre, axes as rows, half-widths,
 /// frame error, all f64 in the model frame).
 macro_rules! box_pair_methods {
     () => {
         #[inline]
-        fn overlaps(&self, other: &Self, xf: &Transform, guard: f64) -> bool {
+        fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
             !self
-                .pair_with(other, xf, $crate::bv::pair::PairSetup::Fast)
+                .pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Fast)
                 .disjoint(guard)
         }
 
         #[inline]
-        fn distance_lower_bound_until(&self, other: &Self, xf: &Transform, enough: f64) -> f64 {
-            self.pair_with(other, xf, $crate::bv::pair::PairSetup::Metric)
+        fn distance_lower_bound_until(&self, other: &Self, b_to_a: &Pose, enough: f64) -> f64 {
+            self.pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Metric)
                 .distance_lower_bound_until(enough)
         }
 
         #[inline]
-        fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
-            self.pair_with(other, xf, $crate::bv::pair::PairSetup::Metric)
+        fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64 {
+            self.pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Metric)
                 .max_distance()
         }
 

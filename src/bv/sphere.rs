@@ -1,12 +1,12 @@
 //! Bounding sphere.
 
-use super::pair::Transform;
 use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, Aabb, BoundingVolume,
     BvDefect, BvKind,
 };
 use crate::arr3;
 use crate::arr3::dot;
+use crate::pose::Pose;
 use crate::real::{point_to_f64, Real};
 use nalgebra::{Matrix3, Vector3};
 use zerocopy::{FromBytes, Immutable, KnownLayout};
@@ -28,8 +28,8 @@ pub struct Sphere<R> {
 impl<R: Real> Sphere<R> {
     /// Distance between the centres once `other` is mapped into this sphere's model frame.
     #[inline]
-    fn center_distance(&self, other: &Self, xf: &Transform) -> f64 {
-        let cb = xf.apply(&Vector3::from(point_to_f64(&other.center)));
+    fn center_distance(&self, other: &Self, b_to_a: &Pose) -> f64 {
+        let cb = b_to_a.apply(&Vector3::from(point_to_f64(&other.center)));
         (cb - Vector3::from(point_to_f64(&self.center))).norm()
     }
 
@@ -114,24 +114,25 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     }
 
     #[inline]
-    fn overlaps(&self, other: &Self, xf: &Transform, _guard: f64) -> bool {
+    fn overlaps(&self, other: &Self, b_to_a: &Pose, _guard: f64) -> bool {
         // A few ulps of slack: the mapped centre is rounded, and a sphere test must never
         // reject a pair that touches.
         let (d, r) = (
-            self.center_distance(other, xf),
+            self.center_distance(other, b_to_a),
             self.radius.to_f64() + other.radius.to_f64(),
         );
         d - r <= 8.0 * f64::EPSILON * (d + r)
     }
 
     #[inline]
-    fn distance_lower_bound_until(&self, other: &Self, xf: &Transform, _enough: f64) -> f64 {
-        (self.center_distance(other, xf) - self.radius.to_f64() - other.radius.to_f64()).max(0.0)
+    fn distance_lower_bound_until(&self, other: &Self, b_to_a: &Pose, _enough: f64) -> f64 {
+        (self.center_distance(other, b_to_a) - self.radius.to_f64() - other.radius.to_f64())
+            .max(0.0)
     }
 
     #[inline]
-    fn max_distance_upper_bound(&self, other: &Self, xf: &Transform) -> f64 {
-        self.center_distance(other, xf) + self.radius.to_f64() + other.radius.to_f64()
+    fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64 {
+        self.center_distance(other, b_to_a) + self.radius.to_f64() + other.radius.to_f64()
     }
 
     fn world_aabb(&self, rotation: &Matrix3<f64>, translation: &Vector3<f64>) -> Aabb<f64> {

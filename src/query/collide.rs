@@ -3,7 +3,7 @@
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangles_intersect, Triangle};
 use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
-use crate::bv::pair::{Transform, SAT_GUARD};
+use crate::bv::pair::SAT_GUARD;
 use crate::bv::BoundingVolume;
 use crate::format::ObbtFile;
 use crate::tree::TreeView;
@@ -52,8 +52,8 @@ impl<B: BoundingVolume> Policy<B> for Collide {
     const ORDERED: bool = false;
 
     #[inline]
-    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64 {
-        if a.overlaps(b, xf, self.guard) {
+    fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64 {
+        if a.overlaps(b, b_to_a, self.guard) {
             0.0
         } else {
             f64::INFINITY
@@ -112,7 +112,7 @@ pub fn collide_into<B: BoundingVolume>(
     context: &mut QueryContext,
     result: &mut CollideResult,
 ) -> Result<(), QueryError> {
-    let xf = Pose::relative(pose_a, pose_b);
+    let b_to_a = Pose::relative(pose_a, pose_b);
     let mut faces = std::mem::take(&mut context.faces);
     faces.clear();
     let mut policy = Collide {
@@ -120,7 +120,7 @@ pub fn collide_into<B: BoundingVolume>(
         first: options.first_contact,
         faces,
     };
-    let traversal = traverse(a, b, &xf, options.rule, &mut policy, context);
+    let traversal = traverse(a, b, &b_to_a, options.rule, &mut policy, context);
     context.faces = policy.faces;
     result.stats = traversal?;
     result.pairs.clear();

@@ -4,7 +4,6 @@
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangle_distance, Triangle};
 use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
-use crate::bv::pair::Transform;
 use crate::bv::BoundingVolume;
 use crate::format::ObbtFile;
 use crate::tree::TreeView;
@@ -179,8 +178,8 @@ impl<B: BoundingVolume> Policy<B> for Distance {
     const ORDERED: bool = true;
 
     #[inline]
-    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64 {
-        a.distance_lower_bound_until(b, xf, self.prune_at())
+    fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64 {
+        a.distance_lower_bound_until(b, b_to_a, self.prune_at())
     }
 
     #[inline]
@@ -223,14 +222,15 @@ fn check(name: &'static str, value: f64) -> Result<(), QueryError> {
     }
 }
 
-/// Triangle `face` of `tree` mapped by `xf`, if the tree holds it.
+/// Triangle `face` of `tree` mapped into A's frame by `to_a` (the identity for A's own
+/// triangles), if the tree holds it.
 fn mapped_triangle<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     face: u32,
-    xf: &Transform,
+    to_a: &Pose,
 ) -> Option<Triangle> {
     tree.triangle(face)
-        .map(|t| t.map(|p| xf.apply(&Vector3::from(p))))
+        .map(|t| t.map(|p| to_a.apply(&Vector3::from(p))))
 }
 
 /// Runs the distance traversal: the warm start first, then the tree pairs. The best pair
@@ -246,20 +246,20 @@ fn run<B: BoundingVolume>(
     warm_start: Option<Witness>,
     context: &mut QueryContext,
 ) -> Result<(Option<DistanceResult>, Stats), QueryError> {
-    let xf = Pose::relative(pose_a, pose_b);
+    let b_to_a = Pose::relative(pose_a, pose_b);
     let mut warm = Stats::default();
     let mut flow = Flow::Continue;
     if let Some(w) = warm_start {
         let pair = (
-            mapped_triangle(a, w.face_a, &Transform::identity()),
-            mapped_triangle(b, w.face_b, &xf),
+            mapped_triangle(a, w.face_a, &Pose::identity()),
+            mapped_triangle(b, w.face_b, &b_to_a),
         );
         if let (Some(ta), Some(tb)) = pair {
             flow = policy.measure(w.face_a, &ta, w.face_b, &tb, &mut warm);
         }
     }
     let mut stats = match flow {
-        Flow::Continue => traverse(a, b, &xf, rule, &mut policy, context)?,
+        Flow::Continue => traverse(a, b, &b_to_a, rule, &mut policy, context)?,
         Flow::Stop => Stats::default(),
     };
     stats.tri_separated += warm.tri_separated;

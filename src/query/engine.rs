@@ -11,8 +11,8 @@ use super::descent::DescentRule;
 use super::stats::Stats;
 use super::triangle::Triangle;
 use super::QueryError;
-use crate::bv::pair::Transform;
 use crate::bv::BoundingVolume;
+use crate::pose::Pose;
 use crate::tree::{NodeDefect, NodeKind, TreeView};
 use nalgebra::Vector3;
 use std::collections::BinaryHeap;
@@ -31,7 +31,7 @@ pub(crate) trait Policy<B: BoundingVolume> {
     const ORDERED: bool;
     /// The key of a volume pair: collision uses 0 (may overlap) or infinity (disjoint);
     /// distance a lower bound; span the negated upper bound. Smaller is more promising.
-    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64;
+    fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64;
     /// Whether a pair with this key still matters (checked when it is taken off the stack
     /// or heap, since the best answer may have improved since it was pushed). Monotone: a
     /// larger key is never kept where a smaller one is not, which lets an ordered
@@ -173,12 +173,12 @@ impl QueryContext {
     }
 }
 
-/// Reads triangle `face` of `tree`, mapped by `xf` (identity for A).
+/// Reads triangle `face` of `tree`, mapped into A's frame by `b_to_a` (`None` for A's own).
 #[inline]
 fn triangle<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     face: u32,
-    xf: Option<&Transform>,
+    b_to_a: Option<&Pose>,
     which: char,
 ) -> Result<Triangle, QueryError> {
     let t = tree.triangle(face).ok_or(QueryError::CorruptTree {
@@ -186,13 +186,13 @@ fn triangle<B: BoundingVolume>(
         what: "face or vertex index out of bounds",
     })?;
     let v = t.map(Vector3::from);
-    Ok(match xf {
-        Some(xf) => v.map(|p| xf.apply(&p)),
+    Ok(match b_to_a {
+        Some(b_to_a) => v.map(|p| b_to_a.apply(&p)),
         None => v,
     })
 }
 
-/// Runs the tandem traversal of `a` and `b` (B mapped into A's frame by `xf`).
+/// Runs the tandem traversal of `a` and `b` (B mapped into A's frame by `b_to_a`).
 ///
 /// Unordered policies (collision) go depth first and test a pair when it is taken, as
 /// RAPID's recursion does: a first-contact query that stops never tests the pairs still
@@ -208,7 +208,7 @@ fn triangle<B: BoundingVolume>(
 pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     a: &TreeView<'_, B>,
     b: &TreeView<'_, B>,
-    xf: &Transform,
+    b_to_a: &Pose,
     rule: DescentRule,
     policy: &mut P,
     context: &mut QueryContext,
@@ -223,9 +223,9 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
         let (Some(ra), Some(rb)) = (a.node(0), b.node(0)) else {
             return Err(corrupt('A', NodeDefect::Missing));
         };
-        let key = ordered_key(policy.key(&ra.bv, &rb.bv, xf));
+        let key = ordered_key(policy.key(&ra.bv, &rb.bv, b_to_a));
         frontier.put(Pending { a: 0, b: 0, key });
-        descend(a, b, xf, rule, policy, &mut frontier)
+        descend(a, b, b_to_a, rule, policy, &mut frontier)
     } else {
         let stack = &mut context.stack;
         stack.clear();
@@ -234,7 +234,7 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
             b: 0,
             key: 0.0,
         });
-        descend(a, b, xf, rule, policy, stack)
+        descend(a, b, b_to_a, rule, policy, stack)
     }
 }
 
@@ -260,7 +260,7 @@ fn ordered_key(key: f64) -> f64 {
 fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
     a: &TreeView<'_, B>,
     b: &TreeView<'_, B>,
-    xf: &Transform,
+    b_to_a: &Pose,
     rule: DescentRule,
     policy: &mut P,
     waiting: &mut W,
@@ -292,7 +292,7 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
         let key = if P::ORDERED {
             key
         } else {
-            policy.key(&na.bv, &nb.bv, xf)
+            policy.key(&na.bv, &nb.bv, b_to_a)
         };
         let kept = if from_dive {
             policy.dive_into(key)
@@ -319,7 +319,7 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 for fa in faces_a {
                     let ta = triangle(a, fa, None, 'A')?;
                     for fb in faces_b.clone() {
-                        let tb = triangle(b, fb, Some(xf), 'B')?;
+                        let tb = triangle(b, fb, Some(b_to_a), 'B')?;
                         if policy.triangles(fa, &ta, fb, &tb, &mut stats) == Flow::Stop {
                             return Ok(stats);
                         }
@@ -327,16 +327,16 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 }
             }
             (NodeKind::Children(children), NodeKind::Faces(_)) => {
-                dive = push_children(a, Side::A, children, &nb.bv, ib, xf, policy, waiting)?
+                dive = push_children(a, Side::A, children, &nb.bv, ib, b_to_a, policy, waiting)?
             }
             (NodeKind::Faces(_), NodeKind::Children(children)) => {
-                dive = push_children(b, Side::B, children, &na.bv, ia, xf, policy, waiting)?
+                dive = push_children(b, Side::B, children, &na.bv, ia, b_to_a, policy, waiting)?
             }
             (NodeKind::Children(children_a), NodeKind::Children(children_b)) => {
                 dive = if rule.descend_a(&na.bv, &nb.bv) {
-                    push_children(a, Side::A, children_a, &nb.bv, ib, xf, policy, waiting)?
+                    push_children(a, Side::A, children_a, &nb.bv, ib, b_to_a, policy, waiting)?
                 } else {
-                    push_children(b, Side::B, children_b, &na.bv, ia, xf, policy, waiting)?
+                    push_children(b, Side::B, children_b, &na.bv, ia, b_to_a, policy, waiting)?
                 }
             }
         }
@@ -399,7 +399,7 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
     children: Range<u32>,
     other_bv: &B,
     other: u32,
-    xf: &Transform,
+    b_to_a: &Pose,
     policy: &P,
     waiting: &mut impl Waiting,
 ) -> Result<Option<Pending>, QueryError> {
@@ -410,8 +410,8 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
                 .node(c)
                 .ok_or(corrupt(side.letter(), NodeDefect::Missing))?;
             ordered_key(match side {
-                Side::A => policy.key(&child.bv, other_bv, xf),
-                Side::B => policy.key(other_bv, &child.bv, xf),
+                Side::A => policy.key(&child.bv, other_bv, b_to_a),
+                Side::B => policy.key(other_bv, &child.bv, b_to_a),
             })
         } else {
             0.0

@@ -3,7 +3,6 @@
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangle_max_distance, Triangle};
 use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
-use crate::bv::pair::Transform;
 use crate::bv::BoundingVolume;
 use crate::format::ObbtFile;
 use crate::tree::TreeView;
@@ -38,8 +37,8 @@ impl<B: BoundingVolume> Policy<B> for Span {
 
     /// The negated upper bound, so that the farthest pairs come first.
     #[inline]
-    fn key(&self, a: &B, b: &B, xf: &Transform) -> f64 {
-        -a.max_distance_upper_bound(b, xf)
+    fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64 {
+        -a.max_distance_upper_bound(b, b_to_a)
     }
 
     #[inline]
@@ -79,14 +78,14 @@ pub fn span<B: BoundingVolume>(
     rule: DescentRule,
     context: &mut QueryContext,
 ) -> Result<SpanResult, QueryError> {
-    let xf = Pose::relative(pose_a, pose_b);
+    let b_to_a = Pose::relative(pose_a, pose_b);
     let mut policy = Span {
         best: -1.0,
         point_a: Vector3::zeros(),
         point_b: Vector3::zeros(),
         faces: (0, 0),
     };
-    let stats = traverse(a, b, &xf, rule, &mut policy, context)?;
+    let stats = traverse(a, b, &b_to_a, rule, &mut policy, context)?;
     if policy.best < 0.0 {
         return Err(QueryError::CorruptTree {
             which: 'A',
