@@ -185,11 +185,11 @@ pub trait BoundingVolume:
     /// `other` (posed as in [`BoundingVolume::overlaps`]).
     fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64;
 
-    /// An axis-aligned box containing this volume once mapped by `p ↦ rotation · p +
-    /// translation` (a model pose): the broad phase of scenes bounds each posed model by
+    /// An axis-aligned box containing this volume once mapped by `pose` (a model's pose: the
+    /// box is in world coordinates): the broad phase of scenes bounds each posed model by
     /// the world box of its root volume, with no traversal. Conservative: widened for the
     /// stored frame's error and for rounding.
-    fn world_aabb(&self, rotation: &Matrix3<f64>, translation: &Vector3<f64>) -> Aabb<f64>;
+    fn world_aabb(&self, pose: &Pose) -> Aabb<f64>;
 
     /// Largest distance between two points of the volume (model units).
     fn diameter(&self) -> f64;
@@ -290,7 +290,7 @@ pub(crate) fn all_finite<R: Real>(values: &[R]) -> bool {
 }
 
 /// The world box of a box volume: centre `center` (model frame), axes the rows of `axes`,
-/// half-widths `half`, mapped by `rotation` and `translation`. Each world extent is
+/// half-widths `half`, mapped by `pose`. Each world extent is
 /// `Σ_i h_i |(R a_i)_k|`; `frame_error` (how far the axes may be from orthonormal) widens
 /// it by that share of the half-widths, and a few ulps of the magnitudes cover rounding.
 pub(crate) fn posed_box_aabb(
@@ -298,9 +298,9 @@ pub(crate) fn posed_box_aabb(
     axes: &Matrix3<f64>,
     half: &Vector3<f64>,
     frame_error: f64,
-    rotation: &Matrix3<f64>,
-    translation: &Vector3<f64>,
+    pose: &Pose,
 ) -> Aabb<f64> {
+    let (rotation, translation) = (pose.rotation(), pose.translation_vector());
     let c = rotation * center + translation;
     // Column i of `world_axes` is axis i in the world.
     let world_axes = rotation * axes.transpose();

@@ -356,13 +356,9 @@ macro_rules! box_pair_methods {
                 .max_distance()
         }
 
-        fn world_aabb(
-            &self,
-            rotation: &nalgebra::Matrix3<f64>,
-            translation: &nalgebra::Vector3<f64>,
-        ) -> $crate::bv::Aabb<f64> {
+        fn world_aabb(&self, pose: &Pose) -> $crate::bv::Aabb<f64> {
             let (center, axes, half, frame_error) = self.local_box();
-            $crate::bv::posed_box_aabb(&center, &axes, &half, frame_error, rotation, translation)
+            $crate::bv::posed_box_aabb(&center, &axes, &half, frame_error, pose)
         }
 
         fn diameter(&self) -> f64 {

@@ -135,10 +135,11 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         self.center_distance(other, b_to_a) + self.radius.to_f64() + other.radius.to_f64()
     }
 
-    fn world_aabb(&self, rotation: &Matrix3<f64>, translation: &Vector3<f64>) -> Aabb<f64> {
-        let c = rotation * Vector3::from(point_to_f64(&self.center)) + translation;
+    fn world_aabb(&self, pose: &Pose) -> Aabb<f64> {
+        let c = pose.apply(&Vector3::from(point_to_f64(&self.center)));
         let r = self.radius.to_f64();
-        let r = r + 16.0 * f64::EPSILON * (c.abs().max() + r + translation.abs().max());
+        let r =
+            r + 16.0 * f64::EPSILON * (c.abs().max() + r + pose.translation_vector().abs().max());
         Aabb {
             min: c.add_scalar(-r).into(),
             max: c.add_scalar(r).into(),

@@ -288,9 +288,7 @@ impl TreeVisitor for RootBounds<'_> {
     type Output = Option<Bounds>;
     fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Option<Bounds> {
         let root = tree.node(0)?;
-        let b = root
-            .bv
-            .world_aabb(self.0.rotation(), self.0.translation_vector());
+        let b = root.bv.world_aabb(self.0);
         Some([b.min, b.max])
     }
 }
