@@ -149,17 +149,20 @@ proptest! {
         }
     }
 
-    /// The bound is near the box distance, not only below it: at least 3/4 of it for
-    /// any pair of separated boxes (the face-axis gaps alone reach only 1/√3 of it for
-    /// boxes diagonal to each other, and nothing like it for thin boxes far apart).
+    /// The bound is near the box distance, not only below it: at least 2/3 of it for
+    /// separated boxes (the face-axis gaps alone reach only 1/√3 of it for boxes
+    /// diagonal to each other, and nothing like it for thin boxes far apart). Not a
+    /// theorem: the worst of 330,000 random separated pairs of this distribution came to
+    /// 0.72 (a claim of 3/4 failed on the case in the regressions file), so a bound made
+    /// looser shows here.
     #[test]
-    fn box_lower_bound_is_at_least_three_quarters_of_the_box_distance(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
+    fn box_lower_bound_is_at_least_two_thirds_of_the_box_distance(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
         let lb = a.distance_lower_bound(&b, &b_to_a);
         let d = surface_distance(&a, &b, &b_to_a);
         prop_assert!(lb <= d + 1e-9, "lower bound {lb} above the surface distance {d}");
         // (Below about 1e-4 the guard's slack, 1e-6 of the boxes' size, takes its share.)
         if d > 1e-3 && !a.overlaps(&b, &b_to_a, 0.0) {
-            prop_assert!(lb >= 0.75 * d, "lower bound {lb} below 3/4 of the distance {d}");
+            prop_assert!(lb >= 2.0 / 3.0 * d, "lower bound {lb} below 2/3 of the distance {d}");
         }
     }
 
@@ -333,3 +336,4 @@ fn thin_boxes_far_apart_are_bounded_along_the_centre_line() {
         );
     }
 }
+
