@@ -336,4 +336,3 @@ fn thin_boxes_far_apart_are_bounded_along_the_centre_line() {
         );
     }
 }
-
