@@ -1,4 +1,6 @@
-//! Builds a mesh repeatedly (for profiling the builder): `cargo run --release --example profile_build -- MESH [FIT] [N]`.
+//! Builds a mesh repeatedly (for profiling the builder):
+//! `cargo run --release --example profile_build -- MESH [FIT] [N] [HULL_MIN_FACES]`
+//! (threads: `RAYON_NUM_THREADS`).
 use obbtree::build::{build, BuildOptions};
 use obbtree::fit::FitMethod;
 use obbtree::mesh::TriMesh;
@@ -6,7 +8,7 @@ use obbtree::mesh::TriMesh;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        eprintln!("usage: profile_build MESH [hull|triangles|vertices] [REPEATS]");
+        eprintln!("usage: profile_build MESH [hull|triangles|vertices] [REPEATS] [HULL_MIN_FACES]");
         std::process::exit(2);
     };
     let mesh = TriMesh::load(path.as_ref()).unwrap_or_else(|e| {
@@ -18,9 +20,14 @@ fn main() {
         .and_then(|s| FitMethod::from_name(s))
         .unwrap_or_default();
     let repeats: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let defaults = BuildOptions::default();
     let options = BuildOptions {
         fit,
-        ..BuildOptions::default()
+        hull_min_faces: args
+            .get(4)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(defaults.hull_min_faces),
+        ..defaults
     };
     for _ in 0..repeats {
         let started = std::time::Instant::now();
