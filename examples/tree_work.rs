@@ -1,8 +1,9 @@
 //! The query work a tree makes, to compare build choices by how well their trees prune:
-//! `cargo run --release --example tree_work -- MESH|sphere [HULL_MIN_FACES] [triangles]`.
+//! `cargo run --release --example tree_work -- MESH|sphere [HULL_MIN_FACES] [HULL_MAX_POINTS]
+//! [triangles]`.
 //!
 //! Builds the mesh (or a 40,000-triangle lat/long sphere) with the default options, or with
-//! the given `hull_min_faces` and fit, then queries it against a turned copy at 40 fixed
+//! the given `hull_min_faces`, `hull_max_points` and fit, then queries it against a turned copy at 40 fixed
 //! poses: all-pairs collision and first contact with the copy moved 0.2 to 0.65 of the
 //! model's diagonal, exact distance with it 1.05 to 3 diagonals away. Prints the
 //! one-thread build time and the summed work (deterministic, unlike the time).
@@ -19,7 +20,7 @@ use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let Some(name) = args.get(1) else {
-        eprintln!("usage: tree_work MESH|sphere [HULL_MIN_FACES] [triangles]");
+        eprintln!("usage: tree_work MESH|sphere [HULL_MIN_FACES] [HULL_MAX_POINTS] [triangles]");
         std::process::exit(2);
     };
     let mesh = if name == "sphere" {
@@ -36,7 +37,11 @@ fn main() {
             .get(2)
             .and_then(|s| s.parse().ok())
             .unwrap_or(defaults.hull_min_faces),
-        fit: match args.get(3).map(String::as_str) {
+        hull_max_points: args
+            .get(3)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(defaults.hull_max_points),
+        fit: match args.get(4).map(String::as_str) {
             Some("triangles") => FitMethod::Triangles,
             _ => defaults.fit,
         },

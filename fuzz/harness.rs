@@ -14,7 +14,9 @@
 #[path = "../tests/common/seal.rs"]
 mod seal;
 
-use obbtree::build::{build, BuildError, BuildOptions, DEFAULT_HULL_MIN_FACES};
+use obbtree::build::{
+    build, BuildError, BuildOptions, DEFAULT_HULL_MAX_POINTS, DEFAULT_HULL_MIN_FACES,
+};
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile};
@@ -93,6 +95,8 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         scale: [1.0, 1e-3, 1e3][(pick / 72) % 3],
         center: (pick / 216) % 2 == 1,
         hull_min_faces: [2, DEFAULT_HULL_MIN_FACES][(pick / 432) % 2],
+        // Small enough that fuzzed meshes get sampled hulls too.
+        hull_max_points: [4, DEFAULT_HULL_MAX_POINTS][(pick / 864) % 2],
     };
     // Fuzzed meshes are small: with the default threshold the hull fit would never run.
     let hull_everywhere = BuildOptions {

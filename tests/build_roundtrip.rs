@@ -302,3 +302,28 @@ fn hull_fit_below_its_threshold_is_the_triangle_fit() {
     // The hull fits the root in both.
     assert_eq!(default.first(), everywhere.first());
 }
+
+/// The hull's vertex sample: a small one changes the tree (the frames of the nodes it
+/// samples) but never what the boxes contain, and a sample of every vertex is the hull of
+/// every vertex.
+#[test]
+fn sampled_hulls_change_frames_only() {
+    let cow = common::cow();
+    let with = |hull_max_points| BuildOptions {
+        hull_min_faces: 1,
+        hull_max_points,
+        ..BuildOptions::default()
+    };
+    let nodes = |options: BuildOptions| -> Vec<Obb<f32>> {
+        let file = build(&cow, &options, None).expect("builds");
+        file.verify().expect("every box contains its triangles");
+        let tree = file.view::<Obb<f32>>().expect("OBB f32");
+        tree.nodes().iter().map(|n| n.bv).collect()
+    };
+    let every_vertex = nodes(with(u32::MAX));
+    // The cow has 2,904 vertices: a sample of as many is every vertex.
+    assert_eq!(nodes(with(2904)), every_vertex);
+    let sampled = nodes(with(64));
+    assert_ne!(sampled.first(), every_vertex.first());
+    assert_eq!(sampled.len(), every_vertex.len());
+}

@@ -915,6 +915,7 @@ fn build_help_states_the_library_defaults() {
     let defaults = obbtree::build::BuildOptions::default();
     for (flag, value) in [
         ("--hull-min-faces", defaults.hull_min_faces.to_string()),
+        ("--hull-max-points", defaults.hull_max_points.to_string()),
         ("--leaf-size", defaults.leaf_size.to_string()),
     ] {
         let at = help

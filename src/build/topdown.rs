@@ -241,7 +241,14 @@ fn fit_and_split<B: BoundingVolume>(
         return (B::new_zeroed(), None);
     }
     let fit = ctx.options.fit_for(faces.len());
-    let axes = principal_axes_and_vertices(fit, ctx.positions, faces, &mut scratch.vertices);
+    let hull_points = ctx.options.hull_max_points as usize;
+    let axes = principal_axes_and_vertices(
+        fit,
+        hull_points,
+        ctx.positions,
+        faces,
+        &mut scratch.vertices,
+    );
     let bv = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
     if faces.len() <= ctx.options.leaf_size as usize {
         if let Some(p) = ctx.progress {

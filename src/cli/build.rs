@@ -83,6 +83,11 @@ pub struct TreeArgs {
     /// cheaper. 1 fits every node to its hull [default: 512].
     #[arg(long, value_name = "N")]
     pub hull_min_faces: Option<u32>,
+    /// With --fit hull, the most vertices a node's hull is computed over: larger nodes
+    /// take it over an evenly spaced sample of this many (and the 6 that reach their
+    /// bounding box). 4294967295 takes every hull over every vertex [default: 2048].
+    #[arg(long, value_name = "N")]
+    pub hull_max_points: Option<u32>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
     /// [default: 1].
     #[arg(long, value_name = "N")]
@@ -144,6 +149,7 @@ impl TreeArgs {
                 PrecisionArg::F64 => Precision::F64,
             }),
             hull_min_faces: self.hull_min_faces.unwrap_or(default.hull_min_faces),
+            hull_max_points: self.hull_max_points.unwrap_or(default.hull_max_points),
             leaf_size: self.leaf_size.unwrap_or(default.leaf_size),
             ..default
         }
@@ -155,6 +161,7 @@ impl TreeArgs {
             ("--bv", self.bv.is_some()),
             ("--fit", self.fit.is_some()),
             ("--hull-min-faces", self.hull_min_faces.is_some()),
+            ("--hull-max-points", self.hull_max_points.is_some()),
             ("--leaf-size", self.leaf_size.is_some()),
             ("--precision", self.precision.is_some()),
         ]

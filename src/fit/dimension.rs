@@ -70,6 +70,12 @@ pub(crate) struct Extremes {
 }
 
 impl Extremes {
+    /// The indices of the six points attaining the bounding box (some may repeat).
+    pub(crate) fn indices(&self) -> [usize; 6] {
+        let [[a, b], [c, d], [e, f]] = self.ext;
+        [a, b, c, d, e, f]
+    }
+
     /// The extremes of the set `{first}` (point 0).
     pub(crate) fn new(first: V3) -> Extremes {
         Extremes {

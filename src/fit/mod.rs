@@ -129,7 +129,7 @@ pub fn principal_axes(
             (Some(&p), Some(&q), Some(&r)) => triangle::triangle_frame(p, q, r),
             _ => Matrix3::identity(),
         },
-        _ => with_scratch(|s| principal::fit(s, method, positions, faces)),
+        _ => with_scratch(|s| principal::fit(s, method, usize::MAX, positions, faces)),
     };
     if frame.iter().all(|v| v.is_finite()) {
         frame
@@ -139,9 +139,13 @@ pub fn principal_axes(
 }
 
 /// [`principal_axes`], also setting `vertices` to the distinct vertex indices of `faces`
-/// (in range, each once, in some deterministic order), which the fit finds anyway.
+/// (in range, each once, in some deterministic order), which the fit finds anyway. With
+/// [`FitMethod::Hull`], a face set of more than `hull_points` distinct vertices has its
+/// hull taken over an evenly spaced sample of `hull_points` of them and the six that reach
+/// its bounding box (`usize::MAX`: every vertex, as [`principal_axes`] does).
 pub(crate) fn principal_axes_and_vertices(
     method: FitMethod,
+    hull_points: usize,
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
     vertices: &mut Vec<u32>,
@@ -154,7 +158,7 @@ pub(crate) fn principal_axes_and_vertices(
         return principal_axes(method, positions, faces);
     }
     let frame = with_scratch(|s| {
-        let frame = principal::fit(s, method, positions, faces);
+        let frame = principal::fit(s, method, hull_points, positions, faces);
         vertices.extend_from_slice(&s.ids);
         frame
     });

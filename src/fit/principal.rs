@@ -9,7 +9,7 @@
 use nalgebra::Matrix3;
 
 use super::covariance::{Moments, Sym3};
-use super::dimension::{classify_with, Shape};
+use super::dimension::{classify, classify_with, Shape};
 use super::eigen::{axes2, axes3};
 use super::frame::{finish, Frame};
 use super::hull::{is_flat, plane_basis};
@@ -29,10 +29,13 @@ enum Source {
     Faces,
 }
 
-/// The frame of `faces` by `method`; see `super::principal_axes` for the contract.
+/// The frame of `faces` by `method`; see `super::principal_axes` for the contract. With
+/// the hull method, a set of more than `hull_points` distinct vertices has its hull taken
+/// over an evenly spaced sample of them (see `super::principal_axes_and_vertices`).
 pub(crate) fn fit(
     s: &mut Scratch,
     method: FitMethod,
+    hull_points: usize,
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
 ) -> Matrix3<f64> {
@@ -62,6 +65,11 @@ pub(crate) fn fit(
 
     let mut result = None;
     if method == FitMethod::Hull {
+        let shape = if s.pts.len() > hull_points {
+            sample(s, hull_points)
+        } else {
+            shape
+        };
         result = hull_frame(s, &shape);
         if result.is_none() {
             tri_cov = triangle_covariance(positions, faces);
@@ -95,6 +103,22 @@ pub(crate) fn fit(
         frame.default_columns()
     };
     finish(c0, c1)
+}
+
+/// Keeps every `k`-th of the gathered points (in the order the faces reference them, so
+/// spread over the node) and the six that attain their bounding box, at most `target + 6`
+/// in all, and classifies the sample. The hull of the sample lies within the set's hull and
+/// reaches its bounding box; the box extents are still taken over every vertex.
+fn sample(s: &mut Scratch, target: usize) -> Shape {
+    let keep = s.extremes.indices();
+    let k = s.pts.len().div_ceil(target.max(1));
+    let mut i = 0;
+    s.pts.retain(|_| {
+        let kept = i % k == 0 || keep.contains(&i);
+        i += 1;
+        kept
+    });
+    classify(&s.pts, s.magnitude)
 }
 
 /// Area covariance of the hull surface (3-D) or polygon (flat), or `None` on failure.
