@@ -27,7 +27,7 @@ mod parry_support;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{Matrix3, Vector3};
-use obbtree::build::{build, BuildOptions, DEFAULT_HULL_MIN_FACES};
+use obbtree::build::{build, BuildOptions, DEFAULT_HULL_MAX_POINTS, DEFAULT_HULL_MIN_FACES};
 use obbtree::bv::pair::SAT_GUARD;
 use obbtree::fit::FitMethod;
 use obbtree::format::ObbtFile;
@@ -49,6 +49,8 @@ struct Config {
     fit: FitMethod,
     /// `BuildOptions::hull_min_faces`.
     hull_min_faces: u32,
+    /// `BuildOptions::hull_max_points`.
+    hull_max_points: u32,
     guard: f64,
     rel_err: f64,
 }
@@ -58,6 +60,7 @@ const BASELINE: Config = Config {
     precision: Precision::F64,
     fit: FitMethod::Hull,
     hull_min_faces: DEFAULT_HULL_MIN_FACES,
+    hull_max_points: DEFAULT_HULL_MAX_POINTS,
     guard: SAT_GUARD,
     rel_err: 0.0,
 };
@@ -85,8 +88,10 @@ const CONFIGS: [Config; 8] = [
         ..BASELINE
     },
     Config {
+        // The dissertation's §3.4 as written: every node, every vertex.
         name: "fit-hull-everywhere",
         hull_min_faces: 1,
+        hull_max_points: u32::MAX,
         ..BASELINE
     },
     Config {
@@ -107,6 +112,7 @@ impl Config {
             precision: self.precision,
             fit: self.fit,
             hull_min_faces: self.hull_min_faces,
+            hull_max_points: self.hull_max_points,
             ..BuildOptions::default()
         }
     }
@@ -116,6 +122,7 @@ impl Config {
         self.precision != BASELINE.precision
             || self.fit != BASELINE.fit
             || self.hull_min_faces != BASELINE.hull_min_faces
+            || self.hull_max_points != BASELINE.hull_max_points
             || self.name == "baseline"
     }
 }
