@@ -32,7 +32,8 @@ pub struct BuildOptions {
     /// With [`FitMethod::Hull`], the fewest faces a node needs for its frame to be fitted to
     /// its convex hull; nodes with fewer are fitted to their triangles
     /// ([`FitMethod::Triangles`]). Default [`DEFAULT_HULL_MIN_FACES`]; 1 fits every node to
-    /// its hull, as §3.4 describes. Ignored by the other methods.
+    /// its hull (with [`BuildOptions::hull_max_points`] at `u32::MAX` too, exactly as §3.4
+    /// describes). Ignored by the other methods.
     pub hull_min_faces: u32,
     /// With [`FitMethod::Hull`], the most vertices a node's hull is computed over: a node
     /// with more has its hull taken over an evenly spaced sample of this many of them and
