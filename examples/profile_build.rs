@@ -1,5 +1,5 @@
 //! Builds a mesh repeatedly (for profiling the builder):
-//! `cargo run --release --example profile_build -- MESH [FIT] [N] [HULL_MIN_FACES]`
+//! `cargo run --release --example profile_build -- MESH [FIT] [N] [HULL_MIN_FACES] [HULL_MAX_POINTS|all]`
 //! (threads: `RAYON_NUM_THREADS`).
 use obbtree::build::{build, BuildOptions};
 use obbtree::fit::FitMethod;
@@ -8,7 +8,9 @@ use obbtree::mesh::TriMesh;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        eprintln!("usage: profile_build MESH [hull|triangles|vertices] [REPEATS] [HULL_MIN_FACES]");
+        eprintln!(
+            "usage: profile_build MESH [hull|triangles|vertices] [REPEATS] [HULL_MIN_FACES] [HULL_MAX_POINTS|all]"
+        );
         std::process::exit(2);
     };
     let mesh = TriMesh::load(path.as_ref()).unwrap_or_else(|e| {
@@ -27,6 +29,12 @@ fn main() {
             .get(4)
             .and_then(|s| s.parse().ok())
             .unwrap_or(defaults.hull_min_faces),
+        hull_max_points: match args.get(5).map(String::as_str) {
+            Some("all") => u32::MAX,
+            other => other
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(defaults.hull_max_points),
+        },
         ..defaults
     };
     for _ in 0..repeats {

@@ -326,4 +326,7 @@ fn sampled_hulls_change_frames_only() {
     let sampled = nodes(with(64));
     assert_ne!(sampled.first(), every_vertex.first());
     assert_eq!(sampled.len(), every_vertex.len());
+    // The smallest sample allowed still builds boxes that contain their triangles.
+    nodes(with(obbtree::build::MIN_HULL_POINTS));
+    assert!(build(&cow, &with(obbtree::build::MIN_HULL_POINTS - 1), None).is_err());
 }

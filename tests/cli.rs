@@ -918,8 +918,9 @@ fn build_help_states_the_library_defaults() {
         ("--hull-max-points", defaults.hull_max_points.to_string()),
         ("--leaf-size", defaults.leaf_size.to_string()),
     ] {
+        // The flag's own entry (`--flag <VALUE>`), not a mention in another's text.
         let at = help
-            .find(flag)
+            .find(&format!("{flag} <"))
             .unwrap_or_else(|| panic!("{flag} in the help"));
         let rest = &help[at..];
         let end = rest.find("[default: ").expect("a stated default");
@@ -953,4 +954,34 @@ fn hull_min_faces_changes_the_tree_and_one_fits_every_node_to_its_hull() {
         let o = obbtree(&["verify", p.to_str().unwrap()]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
+}
+
+#[test]
+fn hull_options_out_of_range_or_without_the_hull_fit_are_exit_1() {
+    let dir = scratch("hull_bad");
+    let out = dir.join("x.obbt");
+    let out = out.to_str().unwrap();
+    let cow = cow();
+    for (extra, needle) in [
+        (&["--hull-max-points", "3"][..], "--hull-max-points"),
+        (&["--hull-min-faces", "0"][..], "--hull-min-faces"),
+        (
+            &["--fit", "triangles", "--hull-min-faces", "5"][..],
+            "applies to --fit hull only",
+        ),
+        (
+            &["--fit", "vertices", "--hull-max-points", "all"][..],
+            "applies to --fit hull only",
+        ),
+    ] {
+        let mut args = vec!["build", cow.as_str(), "-o", out, "--quiet"];
+        args.extend_from_slice(extra);
+        assert_bad_input(&obbtree(&args), needle);
+        assert!(!Path::new(out).exists(), "{extra:?} wrote a file");
+    }
+    // `all` is every vertex.
+    let (all, max) = (dir.join("all.obbt"), dir.join("max.obbt"));
+    build(&all, &["--hull-max-points", "all"]);
+    build(&max, &["--hull-max-points", "4294967295"]);
+    assert_eq!(std::fs::read(&all).unwrap(), std::fs::read(&max).unwrap());
 }

@@ -31,15 +31,17 @@ pub struct BuildOptions {
     pub fit: FitMethod,
     /// With [`FitMethod::Hull`], the fewest faces a node needs for its frame to be fitted to
     /// its convex hull; nodes with fewer are fitted to their triangles
-    /// ([`FitMethod::Triangles`]). Default [`DEFAULT_HULL_MIN_FACES`]; 1 fits every node to
-    /// its hull (with [`BuildOptions::hull_max_points`] at `u32::MAX` too, exactly as §3.4
-    /// describes). Ignored by the other methods.
+    /// ([`FitMethod::Triangles`]). At least 1; default [`DEFAULT_HULL_MIN_FACES`]; 1 fits
+    /// every node to its hull (with [`BuildOptions::hull_max_points`] at `u32::MAX` too,
+    /// exactly as §3.4 describes). Ignored by the other methods.
     pub hull_min_faces: u32,
     /// With [`FitMethod::Hull`], the most vertices a node's hull is computed over: a node
     /// with more has its hull taken over an evenly spaced sample of this many of them and
     /// the six that reach its bounding box (its box extents are still taken over every
-    /// vertex, so this only shapes the frame). Default [`DEFAULT_HULL_MAX_POINTS`];
-    /// `u32::MAX` takes every hull over every vertex.
+    /// vertex, so this only shapes the frame; the sample also stands for the node's points
+    /// where the fit breaks ties between equal eigenvalues). At least 4, the fewest points
+    /// of a solid hull; default [`DEFAULT_HULL_MAX_POINTS`]; `u32::MAX` takes every hull
+    /// over every vertex.
     pub hull_max_points: u32,
     /// Largest number of triangles in a leaf, 1 to 128. With 1 the tree is binary with
     /// single-face leaves and uses the compact binary encoding.
@@ -88,6 +90,9 @@ pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
 /// 1,024 to 8,192 points all stayed within a few percent).
 pub const DEFAULT_HULL_MAX_POINTS: u32 = 2048;
 
+/// The least [`BuildOptions::hull_max_points`]: a solid hull needs four points.
+pub const MIN_HULL_POINTS: u32 = 4;
+
 impl BuildOptions {
     /// The fit of a node of `faces` faces: [`BuildOptions::fit`], except that a
     /// [`FitMethod::Hull`] build fits nodes below [`BuildOptions::hull_min_faces`] to their
@@ -100,11 +105,18 @@ impl BuildOptions {
         }
     }
 
-    /// The checks of the options alone, before any mesh is read: `leaf_size` in 1..=128 and
-    /// a finite `scale` greater than 0. [`build`] runs them too.
+    /// The checks of the options alone, before any mesh is read: `leaf_size` in 1..=128,
+    /// `hull_min_faces` at least 1, `hull_max_points` at least 4 and a finite `scale`
+    /// greater than 0. [`build`] runs them too.
     pub fn validate(&self) -> Result<(), BuildError> {
         if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&self.leaf_size) {
             return Err(BuildError::LeafSize(self.leaf_size));
+        }
+        if self.hull_min_faces < 1 {
+            return Err(BuildError::HullMinFaces(self.hull_min_faces));
+        }
+        if self.hull_max_points < MIN_HULL_POINTS {
+            return Err(BuildError::HullMaxPoints(self.hull_max_points));
         }
         if !Placement::is_valid_scale(self.scale) {
             return Err(BuildError::Scale(self.scale));
@@ -120,6 +132,12 @@ pub enum BuildError {
     /// `leaf_size` outside 1..=128.
     #[error("leaf size {0} is out of range (1 to {VARIABLE_MAX_LEAF_FACES})")]
     LeafSize(u32),
+    /// `hull_min_faces` is 0.
+    #[error("hull min faces {0} is out of range (at least 1; --hull-min-faces)")]
+    HullMinFaces(u32),
+    /// `hull_max_points` is below [`MIN_HULL_POINTS`].
+    #[error("hull max points {0} is out of range (at least {MIN_HULL_POINTS}, or all; --hull-max-points)")]
+    HullMaxPoints(u32),
     /// `scale` is not a finite number greater than 0.
     #[error("scale {0} is not a finite number greater than 0 (--scale)")]
     Scale(f64),

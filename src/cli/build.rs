@@ -78,15 +78,17 @@ pub struct TreeArgs {
     /// triangles (area-weighted), or the vertices [default: hull].
     #[arg(long, value_enum)]
     pub fit: Option<FitArg>,
-    /// With --fit hull, the fewest triangles a node needs to be fitted to its convex hull;
-    /// smaller nodes are fitted to their triangles, which is as tight there and much
-    /// cheaper. 1 fits every node to its hull [default: 512].
+    /// With --fit hull, the fewest triangles (at least 1) a node needs to be fitted to its
+    /// convex hull; smaller nodes are fitted to their triangles, which is as tight there
+    /// and much cheaper. 1 fits every node to its hull (over every vertex too with
+    /// --hull-max-points all: the dissertation's §3.4 exactly) [default: 512].
     #[arg(long, value_name = "N")]
     pub hull_min_faces: Option<u32>,
-    /// With --fit hull, the most vertices a node's hull is computed over: larger nodes
-    /// take it over an evenly spaced sample of this many (and the 6 that reach their
-    /// bounding box). 4294967295 takes every hull over every vertex [default: 2048].
-    #[arg(long, value_name = "N")]
+    /// With --fit hull, the most vertices (at least 4) a node's hull is computed over:
+    /// larger nodes take it over an evenly spaced sample of this many and the 6 that reach
+    /// their bounding box; box extents still cover every vertex. `all` takes every hull
+    /// over every vertex [default: 2048].
+    #[arg(long, value_name = "N|all", value_parser = parse_hull_points)]
     pub hull_max_points: Option<u32>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
     /// [default: 1].
@@ -96,6 +98,15 @@ pub struct TreeArgs {
     /// [default: f32].
     #[arg(long, value_enum)]
     pub precision: Option<PrecisionArg>,
+}
+
+/// `--hull-max-points`: a count, or `all` (no sampling).
+fn parse_hull_points(text: &str) -> Result<u32, String> {
+    if text == "all" {
+        return Ok(u32::MAX);
+    }
+    text.parse()
+        .map_err(|_| format!("{text:?} is not a count of points (or all)"))
 }
 
 /// `--bv` values.
@@ -238,6 +249,18 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     // Bad option values and a refused output are reported before a (possibly large) mesh
     // is read.
     options.validate()?;
+    if options.fit != FitMethod::Hull {
+        let hull_flags = [
+            ("--hull-min-faces", args.tree.hull_min_faces.is_some()),
+            ("--hull-max-points", args.tree.hull_max_points.is_some()),
+        ];
+        if let Some((flag, _)) = hull_flags.iter().find(|(_, given)| *given) {
+            return Err(Failure(format!(
+                "{flag} applies to --fit hull only (this build fits {})",
+                options.fit.name()
+            )));
+        }
+    }
     check_output(&args.output, &[&args.mesh], args.force)?;
     let mesh = load_mesh(&args.mesh)?;
     let label = args.mesh.display().to_string();

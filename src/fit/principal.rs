@@ -107,7 +107,7 @@ pub(crate) fn fit(
 
 /// Keeps every `k`-th of the gathered points (in the order the faces reference them, so
 /// spread over the node) and the six that attain their bounding box, at most `target + 6`
-/// in all, and classifies the sample. The hull of the sample lies within the set's hull and
+/// in all (`target ≥ 1`; builds ask for at least 4), and classifies the sample. The hull of the sample lies within the set's hull and
 /// reaches its bounding box; the box extents are still taken over every vertex.
 fn sample(s: &mut Scratch, target: usize) -> Shape {
     let keep = s.extremes.indices();
