@@ -1,5 +1,5 @@
 //! The query work a tree makes, to compare build choices by how well their trees prune:
-//! `cargo run --release --example tree_work -- MESH|sphere [HULL_MIN_FACES] [HULL_MAX_POINTS]
+//! `cargo run --release --example tree_work -- MESH|sphere [HULL_MIN_FACES] [HULL_MAX_POINTS|all]
 //! [triangles]`.
 //!
 //! Builds the mesh (or a 40,000-triangle lat/long sphere) with the default options, or with
@@ -37,10 +37,12 @@ fn main() {
             .get(2)
             .and_then(|s| s.parse().ok())
             .unwrap_or(defaults.hull_min_faces),
-        hull_max_points: args
-            .get(3)
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(defaults.hull_max_points),
+        hull_max_points: match args.get(3).map(String::as_str) {
+            Some("all") => u32::MAX,
+            other => other
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(defaults.hull_max_points),
+        },
         fit: match args.get(4).map(String::as_str) {
             Some("triangles") => FitMethod::Triangles,
             _ => defaults.fit,
