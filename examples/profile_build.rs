@@ -29,12 +29,10 @@ fn main() {
             .get(4)
             .and_then(|s| s.parse().ok())
             .unwrap_or(defaults.hull_min_faces),
-        hull_max_points: match args.get(5).map(String::as_str) {
-            Some("all") => u32::MAX,
-            other => other
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(defaults.hull_max_points),
-        },
+        hull_max_points: args
+            .get(5)
+            .and_then(|s| BuildOptions::parse_hull_max_points(s))
+            .unwrap_or(defaults.hull_max_points),
         ..defaults
     };
     for _ in 0..repeats {

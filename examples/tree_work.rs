@@ -37,12 +37,10 @@ fn main() {
             .get(2)
             .and_then(|s| s.parse().ok())
             .unwrap_or(defaults.hull_min_faces),
-        hull_max_points: match args.get(3).map(String::as_str) {
-            Some("all") => u32::MAX,
-            other => other
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(defaults.hull_max_points),
-        },
+        hull_max_points: args
+            .get(3)
+            .and_then(|s| BuildOptions::parse_hull_max_points(s))
+            .unwrap_or(defaults.hull_max_points),
         fit: match args.get(4).map(String::as_str) {
             Some("triangles") => FitMethod::Triangles,
             _ => defaults.fit,

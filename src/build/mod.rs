@@ -94,6 +94,16 @@ pub const DEFAULT_HULL_MAX_POINTS: u32 = 2048;
 pub const MIN_HULL_POINTS: u32 = 4;
 
 impl BuildOptions {
+    /// A [`BuildOptions::hull_max_points`] as written on a command line: a count, or `all`
+    /// for every vertex (`u32::MAX`). `None` for anything else; the count's range is
+    /// [`BuildOptions::validate`]'s to check.
+    pub fn parse_hull_max_points(text: &str) -> Option<u32> {
+        match text {
+            "all" => Some(u32::MAX),
+            count => count.parse().ok(),
+        }
+    }
+
     /// The fit of a node of `faces` faces: [`BuildOptions::fit`], except that a
     /// [`FitMethod::Hull`] build fits nodes below [`BuildOptions::hull_min_faces`] to their
     /// triangles.

@@ -102,11 +102,8 @@ pub struct TreeArgs {
 
 /// `--hull-max-points`: a count, or `all` (no sampling).
 fn parse_hull_points(text: &str) -> Result<u32, String> {
-    if text == "all" {
-        return Ok(u32::MAX);
-    }
-    text.parse()
-        .map_err(|_| format!("{text:?} is not a count of points (or all)"))
+    BuildOptions::parse_hull_max_points(text)
+        .ok_or_else(|| format!("{text:?} is not a count of points (or all)"))
 }
 
 /// `--bv` values.
@@ -250,11 +247,8 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     // is read.
     options.validate()?;
     if options.fit != FitMethod::Hull {
-        let hull_flags = [
-            ("--hull-min-faces", args.tree.hull_min_faces.is_some()),
-            ("--hull-max-points", args.tree.hull_max_points.is_some()),
-        ];
-        if let Some((flag, _)) = hull_flags.iter().find(|(_, given)| *given) {
+        let given = args.tree.given();
+        if let Some(flag) = given.iter().find(|flag| flag.starts_with("--hull-")) {
             return Err(Failure(format!(
                 "{flag} applies to --fit hull only (this build fits {})",
                 options.fit.name()
