@@ -56,7 +56,7 @@ impl<R: Real> Obb<R> {
     /// between boxes far apart relative to their size (models 1e6 apart) it would swamp the
     /// bound, so the metric setup then (past [`FAR`]) re-orthonormalises both frames in f64
     /// and widens the half-widths to cover the move, leaving only rounding in the slack.
-    #[inline]
+    #[inline(always)]
     fn pair_with(&self, other: &Self, b_to_a: &Pose, setup: PairSetup) -> BoxPair {
         let tol = axis_tolerance(R::PRECISION);
         let ca = Vector3::from(self.center_f64());

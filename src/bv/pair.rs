@@ -72,7 +72,7 @@ impl BoxPair {
 
     /// As [`BoxPair::new`], given the centre offset `offset = b_to_a(cb) − ca` (model A's
     /// frame) and the rotation of `b_to_a`.
-    #[inline]
+    #[inline(always)]
     pub fn from_offset(
         a_axes: &Matrix3<f64>,
         ha: Vector3<f64>,
@@ -118,7 +118,7 @@ impl BoxPair {
     ///
     /// Every comparison also gets the [`BoxPair::slack`] of frames that are not exactly
     /// orthonormal (f32 axes) and of rounding.
-    #[inline]
+    #[inline(always)]
     // why: 3x3 matrix / 3-vector entries indexed by axis numbers in 0..3 (loop counters and
     // their cyclic successors); the hottest test of every query, kept in the book's form.
     #[allow(clippy::indexing_slicing)]
@@ -178,7 +178,7 @@ impl BoxPair {
     /// it. 0 if the boxes may touch. (The 9 edge-edge axes of the separating-axis test and
     /// the centre-to-box bounds were terms here too: after the second term they pruned
     /// nothing on the bunny and cost 30% of a distance query's instructions, callgrind.)
-    #[inline]
+    #[inline(always)]
     // why: as in `disjoint`, entries indexed by axis numbers in 0..3.
     #[allow(clippy::indexing_slicing)]
     pub fn distance_lower_bound_until(&self, enough: f64) -> f64 {
@@ -266,11 +266,12 @@ impl BoxPair {
         if !(scale > 0.0 && scale.is_finite()) {
             return (0.0, 0.0);
         }
-        let direction = d / scale;
+        // The gap is positively homogeneous in the direction: taken along the unscaled
+        // one and divided by its length once (two divisions where a unit vector took six).
+        let direction = d * (1.0 / scale);
         let length = direction.norm();
-        let u = direction / length;
-        let along_b = m.tr_mul(&u);
-        let gap = u.dot(t) - a.dot(&u.abs()) - b.dot(&along_b.abs());
+        let along_b = m.tr_mul(&direction);
+        let gap = (direction.dot(t) - a.dot(&direction.abs()) - b.dot(&along_b.abs())) / length;
         (gap, scale * length)
     }
 
