@@ -139,7 +139,8 @@ impl Distance {
     /// Whether a volume pair with lower bound `key` may hold a pair closer than the best
     /// answer by more than the allowances `rel_err` and `abs_err`.
     #[inline]
-    fn may_improve(&self, key: f64, rel_err: f64, abs_err: f64) -> bool {
+    fn may_improve(&self, key: f64) -> bool {
+        let (rel_err, abs_err) = (self.rel_err, self.abs_err);
         // Until a first pair is measured without a limit nothing is pruned: a pose far
         // enough out overflows every bound to infinity, and the answer is then an infinite
         // distance, not none.
@@ -184,17 +185,7 @@ impl<B: BoundingVolume> Policy<B> for Distance {
 
     #[inline]
     fn keep(&self, key: f64) -> bool {
-        self.may_improve(key, self.rel_err, self.abs_err)
-    }
-
-    #[inline]
-    fn dive_into(&self, key: f64) -> bool {
-        // With half the error allowances: with all of them, a dive would end above the
-        // best answer's allowance and never find the closer pair that lets everything
-        // else be pruned; with none, it would chase improvements the answer does not need
-        // (30 cow poses, rel_err 0.01: 23,868 pairs without, 20,976 with half; the old
-        // depth-first order 32,195). A child refused here is refused by `keep` too.
-        self.may_improve(key, 0.5 * self.rel_err, 0.5 * self.abs_err)
+        self.may_improve(key)
     }
 
     #[inline]

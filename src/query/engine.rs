@@ -32,21 +32,12 @@ pub(crate) trait Policy<B: BoundingVolume> {
     /// The key of a volume pair: collision uses 0 (may overlap) or infinity (disjoint);
     /// distance a lower bound; span the negated upper bound. Smaller is more promising.
     fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64;
-    /// Whether a pair with this key still matters (checked when it is taken off the stack
-    /// or heap, since the best answer may have improved since it was pushed). Monotone: a
-    /// larger key is never kept where a smaller one is not, which lets an ordered
-    /// traversal stop at the first pruned smallest key.
+    /// Whether a pair with this key still matters (checked when an ordered policy keys a
+    /// pair, and again when it is taken off the stack or heap, since the best answer may
+    /// have improved since). Monotone: a larger key is never kept where a smaller one is
+    /// not, which lets an ordered traversal stop at the first pruned smallest key; and a
+    /// key once refused stays refused (the best answer only improves).
     fn keep(&self, key: f64) -> bool;
-    /// Whether a dive of an ordered traversal continues into a child with this key: by
-    /// default when it is kept. Must hold wherever `keep` does (a refused child is
-    /// dropped). A distance query with an error allowance dives with half of it and
-    /// applies all of it to the pairs it takes off the heap: so it looks for a better
-    /// answer wherever a dive is cheap, and stops once the allowance covers everything
-    /// waiting.
-    #[inline]
-    fn dive_into(&self, key: f64) -> bool {
-        self.keep(key)
-    }
     /// Tests one triangle pair (A's triangle in A's frame, B's mapped into it).
     /// `face_a` / `face_b` are leaf-ordered face indices.
     fn triangles(
@@ -272,7 +263,6 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
     // The child a dive continues with, taken before anything waiting.
     let mut dive: Option<Pending> = None;
     loop {
-        let from_dive = dive.is_some();
         let taken = match dive.take() {
             Some(pair) => Some((pair, false)),
             None => waiting.take(),
@@ -294,11 +284,7 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
         } else {
             policy.key(&na.bv, &nb.bv, b_to_a)
         };
-        let kept = if from_dive {
-            policy.dive_into(key)
-        } else {
-            policy.keep(key)
-        };
+        let kept = policy.keep(key);
         if !kept {
             stats.bv_disjoint += 1;
             if P::ORDERED && smallest {
@@ -327,16 +313,56 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 }
             }
             (NodeKind::Children(children), NodeKind::Faces(_)) => {
-                dive = push_children(a, Side::A, children, &nb.bv, ib, b_to_a, policy, waiting)?
+                dive = push_children(
+                    a,
+                    Side::A,
+                    children,
+                    &nb.bv,
+                    ib,
+                    b_to_a,
+                    policy,
+                    waiting,
+                    &mut stats,
+                )?
             }
             (NodeKind::Faces(_), NodeKind::Children(children)) => {
-                dive = push_children(b, Side::B, children, &na.bv, ia, b_to_a, policy, waiting)?
+                dive = push_children(
+                    b,
+                    Side::B,
+                    children,
+                    &na.bv,
+                    ia,
+                    b_to_a,
+                    policy,
+                    waiting,
+                    &mut stats,
+                )?
             }
             (NodeKind::Children(children_a), NodeKind::Children(children_b)) => {
                 dive = if rule.descend_a(&na.bv, &nb.bv) {
-                    push_children(a, Side::A, children_a, &nb.bv, ib, b_to_a, policy, waiting)?
+                    push_children(
+                        a,
+                        Side::A,
+                        children_a,
+                        &nb.bv,
+                        ib,
+                        b_to_a,
+                        policy,
+                        waiting,
+                        &mut stats,
+                    )?
                 } else {
-                    push_children(b, Side::B, children_b, &na.bv, ia, b_to_a, policy, waiting)?
+                    push_children(
+                        b,
+                        Side::B,
+                        children_b,
+                        &na.bv,
+                        ia,
+                        b_to_a,
+                        policy,
+                        waiting,
+                        &mut stats,
+                    )?
                 }
             }
         }
@@ -391,6 +417,11 @@ impl Side {
 /// Puts the pairs of `side`'s `children` (nodes of `tree`) with the other tree's node
 /// `other` (volume `other_bv`) waiting, keyed now if the policy is ordered; returns the
 /// child pair a dive continues with (see [`keep_smaller`]).
+///
+/// An ordered policy's pair whose key is already pruned is counted as a pruned pair and
+/// dropped rather than put waiting: the best answer only improves, so it would be pruned
+/// when taken too, and a heap push and pop cost more than its key (bunny–fandisk, exact
+/// distance: a fifth of the pairs, with `rel_err` 0.01 half).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn push_children<B: BoundingVolume, P: Policy<B>>(
@@ -402,6 +433,7 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
     b_to_a: &Pose,
     policy: &P,
     waiting: &mut impl Waiting,
+    stats: &mut Stats,
 ) -> Result<Option<Pending>, QueryError> {
     let mut dive = None;
     for c in children {
@@ -409,10 +441,16 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
             let child = tree
                 .node(c)
                 .ok_or(corrupt(side.letter(), NodeDefect::Missing))?;
-            ordered_key(match side {
+            let key = ordered_key(match side {
                 Side::A => policy.key(&child.bv, other_bv, b_to_a),
                 Side::B => policy.key(other_bv, &child.bv, b_to_a),
-            })
+            });
+            if !policy.keep(key) {
+                stats.nodes_visited += 1;
+                stats.bv_disjoint += 1;
+                continue;
+            }
+            key
         } else {
             0.0
         };
