@@ -51,22 +51,61 @@ pub(crate) trait Policy<B: BoundingVolume> {
 }
 
 /// A node pair waiting, with the key computed when it was pushed (ordered policies).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Pending {
-    a: u32,
-    b: u32,
-    key: f64,
-}
+///
+/// Packed into one integer whose order is the heap's: the key's bits mapped so that
+/// unsigned order is [`f64::total_cmp`]'s, then A's node, then B's. Sifting the heap then
+/// compares one `u128` per step instead of a float total order and two tie-breaks (the
+/// heap's sifting was a tenth of an exact distance query's time).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Pending(u128);
 
-/// Pending pairs of an ordered traversal, smallest key on top.
-impl PartialEq for Pending {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == std::cmp::Ordering::Equal
+impl Pending {
+    #[inline(always)]
+    fn new(a: u32, b: u32, key: f64) -> Pending {
+        Pending((u128::from(key_rank(key)) << 64) | (u128::from(a) << 32) | u128::from(b))
+    }
+
+    #[inline(always)]
+    fn a(self) -> u32 {
+        (self.0 >> 32) as u32
+    }
+
+    #[inline(always)]
+    fn b(self) -> u32 {
+        self.0 as u32
+    }
+
+    #[inline(always)]
+    fn key(self) -> f64 {
+        rank_key((self.0 >> 64) as u64)
     }
 }
 
-impl Eq for Pending {}
+/// `key`'s bits, mapped so that their unsigned order is [`f64::total_cmp`]'s order of keys
+/// (negatives have their bits flipped, non-negatives their sign bit set).
+#[inline(always)]
+fn key_rank(key: f64) -> u64 {
+    let bits = key.to_bits();
+    if bits >> 63 == 1 {
+        !bits
+    } else {
+        bits | (1 << 63)
+    }
+}
 
+/// Inverse of [`key_rank`].
+#[inline(always)]
+fn rank_key(rank: u64) -> f64 {
+    f64::from_bits(if rank >> 63 == 1 {
+        rank & !(1 << 63)
+    } else {
+        !rank
+    })
+}
+
+/// Pending pairs of an ordered traversal, smallest key on top: reversed (`BinaryHeap` is
+/// a max-heap) on the key, then on the node indices, so that the order of a traversal
+/// never depends on the heap's layout.
 impl PartialOrd for Pending {
     fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
         Some(self.cmp(other))
@@ -74,14 +113,9 @@ impl PartialOrd for Pending {
 }
 
 impl Ord for Pending {
-    /// Reversed on the key (so `BinaryHeap`, a max-heap, pops the smallest), then on the
-    /// node indices, so that the order of a traversal never depends on the heap's layout.
+    #[inline(always)]
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        other
-            .key
-            .total_cmp(&self.key)
-            .then(other.a.cmp(&self.a))
-            .then(other.b.cmp(&self.b))
+        other.0.cmp(&self.0)
     }
 }
 
@@ -215,16 +249,12 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
             return Err(corrupt('A', NodeDefect::Missing));
         };
         let key = ordered_key(policy.key(&ra.bv, &rb.bv, b_to_a));
-        frontier.put(Pending { a: 0, b: 0, key });
+        frontier.put(Pending::new(0, 0, key));
         descend(a, b, b_to_a, rule, policy, &mut frontier)
     } else {
         let stack = &mut context.stack;
         stack.clear();
-        stack.push(Pending {
-            a: 0,
-            b: 0,
-            key: 0.0,
-        });
+        stack.push(Pending::new(0, 0, 0.0));
         descend(a, b, b_to_a, rule, policy, stack)
     }
 }
@@ -267,9 +297,10 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
             Some(pair) => Some((pair, false)),
             None => waiting.take(),
         };
-        let Some((Pending { a: ia, b: ib, key }, smallest)) = taken else {
+        let Some((pending, smallest)) = taken else {
             break;
         };
+        let (ia, ib, key) = (pending.a(), pending.b(), pending.key());
         stats.nodes_visited += 1;
         if stats.nodes_visited > limit {
             return Err(QueryError::CorruptTree {
@@ -385,7 +416,7 @@ fn keep_smaller<P: Policy<B>, B: BoundingVolume>(
         return None;
     }
     match dive {
-        Some(d) if d.key <= pair.key => {
+        Some(d) if d.key() <= pair.key() => {
             waiting.put(pair);
             Some(d)
         }
@@ -455,16 +486,8 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
             0.0
         };
         let pair = match side {
-            Side::A => Pending {
-                a: c,
-                b: other,
-                key,
-            },
-            Side::B => Pending {
-                a: other,
-                b: c,
-                key,
-            },
+            Side::A => Pending::new(c, other, key),
+            Side::B => Pending::new(other, c, key),
         };
         dive = keep_smaller::<P, B>(dive, pair, waiting);
     }
