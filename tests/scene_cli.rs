@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::cli::{assert_bad_input, obbtree, scratch, stderr};
+use common::cli::{assert_bad_input, obbtree, scratch, stderr, ScratchDir};
 use obbtree::build::{build, BuildOptions};
 use obbtree::mesh::TriMesh;
 use serde_json::Value;
@@ -131,7 +131,7 @@ v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv -0.5 0.5 0.5\nv 0.5 0.5 0.5\n\
 f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\nf 2 4 6\nf 4 8 6\n";
 
 /// A scene directory with a cube mesh, an OBB tree of it and an AABB tree of it.
-fn scene_dir(name: &str) -> PathBuf {
+fn scene_dir(name: &str) -> ScratchDir {
     let dir = scratch(name);
     std::fs::write(dir.join("cube.obj"), CUBE_OBJ).unwrap();
     let obj = dir.join("cube.obj");

@@ -1,6 +1,6 @@
 //! Running the `obbtree` binary from tests, and what its contract says about the outcome.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Runs the binary with `args`.
@@ -11,11 +11,36 @@ pub fn obbtree(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-/// A fresh directory for one test, under the system temporary directory.
-pub fn scratch(name: &str) -> PathBuf {
+/// A fresh directory for one test, under the system temporary directory, removed with
+/// everything in it when the guard is dropped (also when the test fails: rerun it with
+/// the removal commented out to keep the files).
+pub fn scratch(name: &str) -> ScratchDir {
     let dir = std::env::temp_dir().join(format!("obbtree-cli-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir
+    ScratchDir(dir)
+}
+
+/// A test's scratch directory; see [`scratch`].
+#[derive(Debug)]
+pub struct ScratchDir(PathBuf);
+
+impl std::ops::Deref for ScratchDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for ScratchDir {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 /// The bundled cow's path.
