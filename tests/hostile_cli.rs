@@ -48,10 +48,10 @@ enum Ending {
 
 /// Runs the binary with `args`, enforcing the deadline and the exit-status contract.
 fn obbtree(args: &[&str]) -> Ending {
-    let out_dir = scratch("out");
-    let stderr_path = out_dir.join(format!(
-        "stderr-{:?}-{}",
-        std::thread::current().id(),
+    // (A file of its own, removed once read: the runs go on in parallel threads.)
+    let stderr_path = std::env::temp_dir().join(format!(
+        "obbtree-hostile-{}-stderr-{}",
+        std::process::id(),
         COUNTER.fetch_add(1, Ordering::Relaxed)
     ));
     let stderr_file = std::fs::File::create(&stderr_path).expect("a stderr file");
