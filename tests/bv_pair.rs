@@ -178,6 +178,40 @@ proptest! {
     }
 
     #[test]
+    fn enclosing_balls_hold_every_corner(b in arb_box(), far in prop::array::uniform3(-1e6..1e6f64), lo in prop::array::uniform3(-2.0..2.0f64), side in prop::array::uniform3(0.0..1e-3f64)) {
+        // The ball test that culls collision queries at the roots must never cut a corner
+        // off: f64 boxes, the same boxes rounded to f32 (frames then off orthonormal by
+        // ~1e-7) far from the origin, and tiny AABBs far out (rounded centres and halves).
+        let inside = |corners: &[Vector3<f64>], (c, r): ([f64; 3], f64)| {
+            corners.iter().all(|p| (p - Vector3::from(c)).norm() <= r)
+        };
+        prop_assert!(inside(&corners(&b), b.enclosing_ball()));
+        let moved = Obb { center: [b.center[0] + far[0], b.center[1] + far[1], b.center[2] + far[2]], ..b };
+        let narrow = Obb::<f32> {
+            axes: moved.axes.map(|row| row.map(|v| v as f32)),
+            center: moved.center.map(|v| v as f32),
+            half: moved.half.map(|v| v as f32),
+        };
+        let widened = Obb {
+            axes: narrow.axes.map(|row| row.map(f64::from)),
+            center: narrow.center.map(f64::from),
+            half: narrow.half.map(f64::from),
+        };
+        prop_assert!(inside(&corners(&widened), narrow.enclosing_ball()));
+        let min = [far[0] + lo[0], far[1] + lo[1], far[2] + lo[2]];
+        let max = [min[0] + side[0], min[1] + side[1], min[2] + side[2]];
+        let aabb = Aabb { min, max };
+        let box_corners: Vec<Vector3<f64>> = (0..8)
+            .map(|k| Vector3::new(
+                if k & 1 == 0 { min[0] } else { max[0] },
+                if k & 2 == 0 { min[1] } else { max[1] },
+                if k & 4 == 0 { min[2] } else { max[2] },
+            ))
+            .collect();
+        prop_assert!(inside(&box_corners, aabb.enclosing_ball()));
+    }
+
+    #[test]
     fn spheres_and_aabbs_agree_with_points(c1 in prop::array::uniform3(-2.0..2.0f64), c2 in prop::array::uniform3(-2.0..2.0f64), r1 in 0.0..1.5f64, r2 in 0.0..1.5f64, b_to_a in arb_relative_pose()) {
         let s1 = Sphere { center: c1, radius: r1 };
         let s2 = Sphere { center: c2, radius: r2 };

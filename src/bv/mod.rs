@@ -191,6 +191,11 @@ pub trait BoundingVolume:
     /// stored frame's error and for rounding.
     fn world_aabb(&self, pose: &Pose) -> Aabb<f64>;
 
+    /// A ball containing the volume: centre (model frame) and radius (model units), widened
+    /// for the stored frame's error and for rounding. Testing two such balls costs a tenth
+    /// of a box test, which is what a collision query culled at the roots needs.
+    fn enclosing_ball(&self) -> ([f64; 3], f64);
+
     /// Largest distance between two points of the volume (model units).
     fn diameter(&self) -> f64;
     /// Enclosed volume (cubic model units).

@@ -358,6 +358,16 @@ macro_rules! box_pair_methods {
             $crate::bv::posed_box_aabb(&center, &axes, &half, frame_error, pose)
         }
 
+        fn enclosing_ball(&self) -> ([f64; 3], f64) {
+            let (center, _, half, frame_error) = self.local_box();
+            // Axes within `frame_error` of orthonormal stretch a box's half-diagonal by at
+            // most 2.5 times that share; the norm, and an AABB's centre and half-widths
+            // (halved sums), are off by a few ulps of their magnitudes.
+            let radius = half.norm() * (1.0 + 4.0 * frame_error + 8.0 * f64::EPSILON)
+                + 4.0 * f64::EPSILON * center.abs().sum();
+            (center.into(), radius)
+        }
+
         fn diameter(&self) -> f64 {
             $crate::bv::obb::box_measures(self.half_f64()).0
         }

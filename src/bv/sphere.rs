@@ -146,6 +146,10 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         }
     }
 
+    fn enclosing_ball(&self) -> ([f64; 3], f64) {
+        (point_to_f64(&self.center), self.radius.to_f64())
+    }
+
     fn diameter(&self) -> f64 {
         2.0 * self.radius.to_f64()
     }
