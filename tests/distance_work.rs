@@ -67,16 +67,15 @@ fn distance_work_on_the_cow_is_pinned() {
     // Before pairs pruned when keyed were dropped at once (and counted: at a touching pose
     // the traversal stops with pairs still waiting, which were not counted) and dives
     // took 0.7 of rel_err rather than half: exact (55,160, 3,607), rel_err 0.01
-    // (25,140, 617); then before B's face axes left the bound: exact (55,746, 3,607),
-    // rel_err 0.01 (24,783, 538).
+    // (25,140, 617).
     assert_eq!(
         total(&exact),
-        (55_750, 3_607),
+        (55_746, 3_607),
         "exact: node pairs, triangle pairs"
     );
     assert_eq!(
         total(&rel),
-        (24_697, 535),
+        (24_783, 538),
         "rel_err 0.01: node pairs, triangle pairs"
     );
 }
