@@ -168,7 +168,9 @@ impl BoxPair {
     /// of cost, stopping after the first if it reaches `enough`:
     ///
     /// - the gaps between their projections on the 6 face axes (tight for boxes side by
-    ///   side, and most pairs a traversal tests are pruned by them);
+    ///   side; B's three cost 3% of a query between mesh pairs for no pruning, but
+    ///   between concentric spheres, one turned, they save 7% of the pairs and a third of
+    ///   the time with `rel_err` 0.01);
     /// - the gap on the direction between nearly closest points
     ///   ([`BoxPair::closest_direction_gap`]), near the box distance wherever the axis gaps
     ///   fall short of it: up to a factor √3 for boxes diagonal to each other, and without
