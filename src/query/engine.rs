@@ -346,7 +346,8 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
         stats.bv_overlap += 1;
         let kind_a = a.node_kind(ia).map_err(|d| corrupt('A', d))?;
         let kind_b = b.node_kind(ib).map_err(|d| corrupt('B', d))?;
-        match (kind_a, kind_b) {
+        // The tree a step descends, and its node's children.
+        let (side, children) = match (kind_a, kind_b) {
             (NodeKind::Faces(faces_a), NodeKind::Faces(faces_b)) => {
                 for fa in faces_a {
                     let ta = triangle(a, fa, None, 'A')?;
@@ -357,61 +358,25 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                         }
                     }
                 }
+                continue;
             }
-            (NodeKind::Children(children), NodeKind::Faces(_)) => {
-                dive = push_children(
-                    a,
-                    Side::A,
-                    children,
-                    &nb.bv,
-                    ib,
-                    b_to_a,
-                    policy,
-                    waiting,
-                    &mut stats,
-                )?
-            }
-            (NodeKind::Faces(_), NodeKind::Children(children)) => {
-                dive = push_children(
-                    b,
-                    Side::B,
-                    children,
-                    &na.bv,
-                    ia,
-                    b_to_a,
-                    policy,
-                    waiting,
-                    &mut stats,
-                )?
-            }
+            (NodeKind::Children(children), NodeKind::Faces(_)) => (Side::A, children),
+            (NodeKind::Faces(_), NodeKind::Children(children)) => (Side::B, children),
             (NodeKind::Children(children_a), NodeKind::Children(children_b)) => {
-                dive = if rule.descend_a(&na.bv, &nb.bv) {
-                    push_children(
-                        a,
-                        Side::A,
-                        children_a,
-                        &nb.bv,
-                        ib,
-                        b_to_a,
-                        policy,
-                        waiting,
-                        &mut stats,
-                    )?
+                if rule.descend_a(&na.bv, &nb.bv) {
+                    (Side::A, children_a)
                 } else {
-                    push_children(
-                        b,
-                        Side::B,
-                        children_b,
-                        &na.bv,
-                        ia,
-                        b_to_a,
-                        policy,
-                        waiting,
-                        &mut stats,
-                    )?
+                    (Side::B, children_b)
                 }
             }
-        }
+        };
+        let (tree, other_bv, other) = match side {
+            Side::A => (a, &nb.bv, ib),
+            Side::B => (b, &na.bv, ia),
+        };
+        dive = push_children(
+            tree, side, children, other_bv, other, b_to_a, policy, waiting, &mut stats,
+        )?;
     }
     Ok(stats)
 }
