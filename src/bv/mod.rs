@@ -191,6 +191,9 @@ pub trait BoundingVolume:
     /// stored frame's error and for rounding.
     fn world_aabb(&self, pose: &Pose) -> Aabb<f64>;
 
+    /// The volume's centre, model frame.
+    fn center(&self) -> [f64; 3];
+
     /// A ball containing the volume: centre (model frame) and radius (model units), widened
     /// for the stored frame's error and for rounding. Testing two such balls costs a tenth
     /// of a box test, which is what a collision query culled at the roots needs.

@@ -364,6 +364,11 @@ macro_rules! box_pair_methods {
             $crate::bv::posed_box_aabb(&center, &axes, &half, frame_error, pose)
         }
 
+        #[inline]
+        fn center(&self) -> [f64; 3] {
+            self.local_box().0.into()
+        }
+
         fn enclosing_ball(&self) -> ([f64; 3], f64) {
             let (center, _, half, frame_error) = self.local_box();
             // Axes within `frame_error` of orthonormal stretch a box's half-diagonal by at

@@ -146,6 +146,11 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         }
     }
 
+    #[inline]
+    fn center(&self) -> [f64; 3] {
+        point_to_f64(&self.center)
+    }
+
     fn enclosing_ball(&self) -> ([f64; 3], f64) {
         (point_to_f64(&self.center), self.radius.to_f64())
     }

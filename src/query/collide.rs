@@ -67,6 +67,11 @@ impl<B: BoundingVolume> Policy<B> for Collide {
     }
 
     #[inline]
+    fn nearest_first(&self) -> bool {
+        self.first
+    }
+
+    #[inline]
     fn triangles(
         &mut self,
         fa: u32,

@@ -38,6 +38,13 @@ pub(crate) trait Policy<B: BoundingVolume> {
     /// traversal stop at the first pruned smallest key; and a key once refused stays
     /// refused (the best answer only improves).
     fn keep(&self, key: f64) -> bool;
+    /// Whether an unordered traversal takes the children of a step nearest first (by the
+    /// distance between the centres of their enclosing balls and the other node's), rather
+    /// than in stored order: worth its cost when the query stops at its first find.
+    #[inline]
+    fn nearest_first(&self) -> bool {
+        false
+    }
     /// Whether a dive of an ordered traversal continues into a child with this key: by
     /// default when it is kept. Must hold wherever `keep` does, with the same monotony (a
     /// child refused here is dropped for good, when it is keyed). A distance query with an
@@ -381,6 +388,59 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
     Ok(stats)
 }
 
+/// Puts the pairs of `side`'s two `children` with the other tree's node `other` on the
+/// stack nearer last, so that the nearer is taken first: the distance between the volumes'
+/// centres, a cheap guess at where contact is. (Wider nodes, of the variable encoding, go
+/// in stored order.)
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn push_nearest_last<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    side: Side,
+    children: Range<u32>,
+    other_bv: &B,
+    other: u32,
+    b_to_a: &Pose,
+    waiting: &mut impl Waiting,
+) -> Result<(), QueryError> {
+    let pair = |c: u32| match side {
+        Side::A => Pending::new(c, other, 0.0),
+        Side::B => Pending::new(other, c, 0.0),
+    };
+    let (first, second) = (children.start, children.start.wrapping_add(1));
+    if children.len() != 2 {
+        for c in children {
+            waiting.put(pair(c));
+        }
+        return Ok(());
+    }
+    // Centres in A's frame, where B's are mapped.
+    let in_a = |bv: &B, of_b: bool| {
+        let c = Vector3::from(bv.center());
+        if of_b {
+            b_to_a.apply(&c)
+        } else {
+            c
+        }
+    };
+    let other_centre = in_a(other_bv, side == Side::A);
+    let distance = |c: u32| -> Result<f64, QueryError> {
+        let child = tree
+            .node(c)
+            .ok_or(corrupt(side.letter(), NodeDefect::Missing))?;
+        Ok((in_a(&child.bv, side == Side::B) - other_centre).norm_squared())
+    };
+    // (A NaN distance, from a damaged file, compares false: stored order.)
+    if distance(second)? < distance(first)? {
+        waiting.put(pair(first));
+        waiting.put(pair(second));
+    } else {
+        waiting.put(pair(second));
+        waiting.put(pair(first));
+    }
+    Ok(())
+}
+
 /// For an ordered policy, the smaller-keyed of `dive` and `pair`, the other put waiting
 /// (the traversal continues with the closest child at once: a greedy dive that reaches a
 /// triangle pair, and a first answer to prune with, in one step per level). Unordered
@@ -446,6 +506,10 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
     waiting: &mut impl Waiting,
     stats: &mut Stats,
 ) -> Result<Option<Pending>, QueryError> {
+    if !P::ORDERED && policy.nearest_first() {
+        push_nearest_last(tree, side, children, other_bv, other, b_to_a, waiting)?;
+        return Ok(None);
+    }
     let mut dive = None;
     for c in children {
         let key = if P::ORDERED {
