@@ -97,6 +97,7 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         hull_min_faces: [2, DEFAULT_HULL_MIN_FACES][(pick / 432) % 2],
         // Small enough that fuzzed meshes get sampled hulls too.
         hull_max_points: [4, DEFAULT_HULL_MAX_POINTS][(pick / 864) % 2],
+        model_axes: (pick / 1728) % 2 == 0,
     };
     // Fuzzed meshes are small: with the default threshold the hull fit would never run.
     let hull_everywhere = BuildOptions {

@@ -309,9 +309,12 @@ fn hull_fit_below_its_threshold_is_the_triangle_fit() {
 #[test]
 fn sampled_hulls_change_frames_only() {
     let cow = common::cow();
+    // (Fitted frames only: the model's axes, which a sample does not change, would win at
+    // the root.)
     let with = |hull_max_points| BuildOptions {
         hull_min_faces: 1,
         hull_max_points,
+        model_axes: false,
         ..BuildOptions::default()
     };
     let nodes = |options: BuildOptions| -> Vec<Obb<f32>> {
@@ -329,4 +332,41 @@ fn sampled_hulls_change_frames_only() {
     // The smallest sample allowed still builds boxes that contain their triangles.
     nodes(with(obbtree::build::MIN_HULL_POINTS));
     assert!(build(&cow, &with(obbtree::build::MIN_HULL_POINTS - 1), None).is_err());
+}
+
+/// The model's axes as a candidate frame: a node keeps the box on them only where it is
+/// smaller, so the root's box is never larger than the fitted one, some nodes of the cow
+/// lie on the model's axes, and every box still contains its triangles.
+#[test]
+fn model_axes_replace_a_fitted_box_only_where_theirs_is_smaller() {
+    let cow = common::cow();
+    let fitted_only = BuildOptions {
+        model_axes: false,
+        ..BuildOptions::default()
+    };
+    let (either, fitted) = (
+        build(&cow, &BuildOptions::default(), None).expect("builds"),
+        build(&cow, &fitted_only, None).expect("builds"),
+    );
+    for file in [&either, &fitted] {
+        file.verify().expect("every box contains its triangles");
+    }
+    assert_ne!(either.bytes(), fitted.bytes());
+    let nodes = |file: &obbtree::format::ObbtFile| -> Vec<Obb<f32>> {
+        let tree = file.view::<Obb<f32>>().expect("OBB f32");
+        tree.nodes().iter().map(|n| n.bv).collect()
+    };
+    let (with, without) = (nodes(&either), nodes(&fitted));
+    assert!(with[0].volume() <= without[0].volume());
+    let on_model_axes = |b: &Obb<f32>| {
+        b.axes
+            .iter()
+            .all(|row| row.iter().filter(|v| v.abs() == 1.0).count() == 1)
+    };
+    let aligned = with.iter().filter(|b| on_model_axes(b)).count();
+    let aligned_without = without.iter().filter(|b| on_model_axes(b)).count();
+    assert!(
+        aligned > aligned_without,
+        "{aligned} nodes on the model's axes with the candidate, {aligned_without} without"
+    );
 }

@@ -917,6 +917,10 @@ fn build_help_states_the_library_defaults() {
         ("--hull-min-faces", defaults.hull_min_faces.to_string()),
         ("--hull-max-points", defaults.hull_max_points.to_string()),
         ("--leaf-size", defaults.leaf_size.to_string()),
+        (
+            "--model-axes",
+            if defaults.model_axes { "yes" } else { "no" }.to_string(),
+        ),
     ] {
         // The flag's own entry (`--flag <VALUE>`), not a mention in another's text.
         let at = help
@@ -984,4 +988,32 @@ fn hull_options_out_of_range_or_without_the_hull_fit_are_exit_1() {
     build(&all, &["--hull-max-points", "all"]);
     build(&max, &["--hull-max-points", "4294967295"]);
     assert_eq!(std::fs::read(&all).unwrap(), std::fs::read(&max).unwrap());
+}
+
+#[test]
+fn model_axes_no_changes_the_tree_and_other_words_are_refused() {
+    let dir = scratch("model_axes");
+    let (default, fitted) = (dir.join("default.obbt"), dir.join("fitted.obbt"));
+    build(&default, &[]);
+    build(&fitted, &["--model-axes", "no"]);
+    assert_ne!(
+        std::fs::read(&default).unwrap(),
+        std::fs::read(&fitted).unwrap()
+    );
+    for p in [&default, &fitted] {
+        let o = obbtree(&["verify", p.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let out = dir.join("bad.obbt");
+    let o = obbtree(&[
+        "build",
+        cow().as_str(),
+        "-o",
+        out.to_str().unwrap(),
+        "--model-axes",
+        "maybe",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--model-axes"), "{}", stderr(&o));
+    assert!(!out.exists());
 }

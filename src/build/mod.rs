@@ -32,8 +32,8 @@ pub struct BuildOptions {
     /// With [`FitMethod::Hull`], the fewest faces a node needs for its frame to be fitted to
     /// its convex hull; nodes with fewer are fitted to their triangles
     /// ([`FitMethod::Triangles`]). At least 1; default [`DEFAULT_HULL_MIN_FACES`]; 1 fits
-    /// every node to its hull (with [`BuildOptions::hull_max_points`] at `u32::MAX` too,
-    /// exactly as §3.4 describes). Ignored by the other methods.
+    /// every node to its hull (with [`BuildOptions::hull_max_points`] at `u32::MAX` and
+    /// [`BuildOptions::model_axes`] off too, exactly as §3.4 describes). Ignored by the other methods.
     pub hull_min_faces: u32,
     /// With [`FitMethod::Hull`], the most vertices a node's hull is computed over: a node
     /// with more has its hull taken over an evenly spaced sample of this many of them and
@@ -43,6 +43,15 @@ pub struct BuildOptions {
     /// of a solid hull; default [`DEFAULT_HULL_MAX_POINTS`]; `u32::MAX` takes every hull
     /// over every vertex.
     pub hull_max_points: u32,
+    /// Also fit each node's volume to the model's own axes and keep that one wherever its
+    /// volume is smaller than the fitted frame's (default on). Parts modelled along their
+    /// axes (CAD) have many nodes whose covariance frame is tilted against their flat sides:
+    /// with the turned copy of `tree_work`, fandisk's distance queries visited 56% fewer
+    /// node pairs, the bunny, pig and cow 5 to 14% fewer, and every mesh's collisions 1 to
+    /// 6% fewer box tests, for 4 to 6% more build time. Off (with
+    /// [`BuildOptions::hull_min_faces`] 1 and [`BuildOptions::hull_max_points`] `u32::MAX`)
+    /// gives §3.4 exactly.
+    pub model_axes: bool,
     /// Largest number of triangles in a leaf, 1 to 128. With 1 the tree is binary with
     /// single-face leaves and uses the compact binary encoding.
     pub leaf_size: u32,
@@ -64,6 +73,7 @@ impl Default for BuildOptions {
             hull_min_faces: DEFAULT_HULL_MIN_FACES,
             hull_max_points: DEFAULT_HULL_MAX_POINTS,
             leaf_size: 1,
+            model_axes: true,
             scale: 1.0,
             center: false,
         }

@@ -7,7 +7,7 @@
 
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
-use crate::fit::{principal_axes, principal_axes_and_vertices, FitMethod};
+use crate::fit::{model_axes_frame, principal_axes, principal_axes_and_vertices, FitMethod};
 use crate::format::NodeRun;
 use crate::stats::TreeShape;
 use crate::tree::{Draft, NodeRef};
@@ -249,7 +249,19 @@ fn fit_and_split<B: BoundingVolume>(
         faces,
         &mut scratch.vertices,
     );
-    let bv = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
+    let fitted = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
+    let (axes, bv) = if ctx.options.model_axes {
+        let model = model_axes_frame(ctx.positions, &scratch.vertices);
+        let aligned = B::enclose_vertices(&model, ctx.positions, &scratch.vertices);
+        // The fitted frame wins ties.
+        if aligned.volume() < fitted.volume() {
+            (model, aligned)
+        } else {
+            (axes, fitted)
+        }
+    } else {
+        (axes, fitted)
+    };
     if faces.len() <= ctx.options.leaf_size as usize {
         if let Some(p) = ctx.progress {
             p.fetch_add(faces.len() as u64, Ordering::Relaxed);

@@ -81,7 +81,8 @@ pub struct TreeArgs {
     /// With --fit hull, the fewest triangles (at least 1) a node needs to be fitted to its
     /// convex hull; smaller nodes are fitted to their triangles, which is as tight there
     /// and much cheaper. 1 fits every node to its hull (over every vertex too with
-    /// --hull-max-points all: the dissertation's §3.4 exactly) [default: 512].
+    /// --hull-max-points all and --model-axes no: the dissertation's §3.4 exactly)
+    /// [default: 512].
     #[arg(long, value_name = "N")]
     pub hull_min_faces: Option<u32>,
     /// With --fit hull, the most vertices (at least 4) a node's hull is computed over:
@@ -90,6 +91,10 @@ pub struct TreeArgs {
     /// over every vertex [default: 2048].
     #[arg(long, value_name = "N|all", value_parser = parse_hull_points)]
     pub hull_max_points: Option<u32>,
+    /// Also fit each node's box to the model's own axes, and keep that box wherever it is
+    /// smaller: parts modelled along their axes (CAD) get much tighter boxes [default: yes].
+    #[arg(long, value_name = "yes|no", value_parser = parse_yes_no)]
+    pub model_axes: Option<bool>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
     /// [default: 1].
     #[arg(long, value_name = "N")]
@@ -98,6 +103,15 @@ pub struct TreeArgs {
     /// [default: f32].
     #[arg(long, value_enum)]
     pub precision: Option<PrecisionArg>,
+}
+
+/// `--model-axes`: `yes` or `no`.
+fn parse_yes_no(text: &str) -> Result<bool, String> {
+    match text {
+        "yes" => Ok(true),
+        "no" => Ok(false),
+        _ => Err(format!("{text:?} is not yes or no")),
+    }
 }
 
 /// `--hull-max-points`: a count, or `all` (no sampling).
@@ -159,6 +173,7 @@ impl TreeArgs {
             hull_min_faces: self.hull_min_faces.unwrap_or(default.hull_min_faces),
             hull_max_points: self.hull_max_points.unwrap_or(default.hull_max_points),
             leaf_size: self.leaf_size.unwrap_or(default.leaf_size),
+            model_axes: self.model_axes.unwrap_or(default.model_axes),
             ..default
         }
     }
