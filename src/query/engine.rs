@@ -11,7 +11,7 @@ use super::descent::DescentRule;
 use super::stats::Stats;
 use super::triangle::Triangle;
 use super::QueryError;
-use crate::bv::BoundingVolume;
+use crate::bv::{BoundingVolume, Node};
 use crate::pose::Pose;
 use crate::tree::{NodeDefect, NodeKind, TreeView};
 use nalgebra::Vector3;
@@ -377,36 +377,67 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 }
             }
         };
-        let (tree, other_bv, other) = match side {
-            Side::A => (a, &nb.bv, ib),
-            Side::B => (b, &na.bv, ia),
+        let step = match side {
+            Side::A => Step {
+                tree: a,
+                side,
+                children,
+                other_bv: &nb.bv,
+                other: ib,
+            },
+            Side::B => Step {
+                tree: b,
+                side,
+                children,
+                other_bv: &na.bv,
+                other: ia,
+            },
         };
-        dive = push_children(
-            tree, side, children, other_bv, other, b_to_a, policy, waiting, &mut stats,
-        )?;
+        dive = push_children(&step, b_to_a, policy, waiting, &mut stats)?;
     }
     Ok(stats)
 }
 
-/// Puts the pairs of `side`'s two `children` with the other tree's node `other` on the
-/// stack nearer last, so that the nearer is taken first: the distance between the volumes'
-/// centres, a cheap guess at where contact is. (Wider nodes, of the variable encoding, go
-/// in stored order.)
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn push_nearest_last<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+/// One step of a traversal: `side`'s node is descended into its `children` (nodes of
+/// `tree`), each paired with the other tree's node `other` (volume `other_bv`).
+struct Step<'s, 't, B: BoundingVolume> {
+    tree: &'s TreeView<'t, B>,
     side: Side,
     children: Range<u32>,
-    other_bv: &B,
+    other_bv: &'s B,
     other: u32,
+}
+
+impl<B: BoundingVolume> Step<'_, '_, B> {
+    /// The pair of child `c` and the other node, with `key`.
+    #[inline(always)]
+    fn pair(&self, c: u32, key: f64) -> Pending {
+        match self.side {
+            Side::A => Pending::new(c, self.other, key),
+            Side::B => Pending::new(self.other, c, key),
+        }
+    }
+
+    /// Child `c`'s node record.
+    #[inline(always)]
+    fn child(&self, c: u32) -> Result<&Node<B>, QueryError> {
+        self.tree
+            .node(c)
+            .ok_or(corrupt(self.side.letter(), NodeDefect::Missing))
+    }
+}
+
+/// Puts the pairs of a step's two children on the stack nearer last, so that the nearer is
+/// taken first: the distance between the volumes' centres, a cheap guess at where contact
+/// is. (Wider nodes, of the variable encoding, go in stored order.)
+#[inline(always)]
+fn push_nearest_last<B: BoundingVolume>(
+    step: &Step<'_, '_, B>,
     b_to_a: &Pose,
     waiting: &mut impl Waiting,
 ) -> Result<(), QueryError> {
-    let pair = |c: u32| match side {
-        Side::A => Pending::new(c, other, 0.0),
-        Side::B => Pending::new(other, c, 0.0),
-    };
+    let (side, children) = (step.side, step.children.clone());
+    let pair = |c: u32| step.pair(c, 0.0);
     let (first, second) = (children.start, children.start.wrapping_add(1));
     if children.len() != 2 {
         for c in children {
@@ -423,11 +454,9 @@ fn push_nearest_last<B: BoundingVolume>(
             c
         }
     };
-    let other_centre = in_a(other_bv, side == Side::A);
+    let other_centre = in_a(step.other_bv, side == Side::A);
     let distance = |c: u32| -> Result<f64, QueryError> {
-        let child = tree
-            .node(c)
-            .ok_or(corrupt(side.letter(), NodeDefect::Missing))?;
+        let child = step.child(c)?;
         Ok((in_a(&child.bv, side == Side::B) - other_centre).norm_squared())
     };
     // (A NaN distance, from a damaged file, compares false: stored order.)
@@ -485,40 +514,33 @@ impl Side {
     }
 }
 
-/// Puts the pairs of `side`'s `children` (nodes of `tree`) with the other tree's node
-/// `other` (volume `other_bv`) waiting, keyed now if the policy is ordered; returns the
-/// child pair a dive continues with (see [`keep_smaller`]).
+/// Puts the pairs of a step's children with the other tree's node waiting, keyed now if
+/// the policy is ordered; returns the child pair a dive continues with (see
+/// [`keep_smaller`]).
 ///
 /// An ordered policy's pair whose key even a dive refuses is counted as a pruned pair and
 /// dropped rather than put waiting: the best answer only improves, so it would be refused
 /// when taken too, and a heap push and pop cost more than its key (bunny–fandisk, exact
 /// distance: a fifth of the pairs, with `rel_err` 0.01 half).
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn push_children<B: BoundingVolume, P: Policy<B>>(
-    tree: &TreeView<'_, B>,
-    side: Side,
-    children: Range<u32>,
-    other_bv: &B,
-    other: u32,
+    step: &Step<'_, '_, B>,
     b_to_a: &Pose,
     policy: &P,
     waiting: &mut impl Waiting,
     stats: &mut Stats,
 ) -> Result<Option<Pending>, QueryError> {
     if !P::ORDERED && policy.nearest_first() {
-        push_nearest_last(tree, side, children, other_bv, other, b_to_a, waiting)?;
+        push_nearest_last(step, b_to_a, waiting)?;
         return Ok(None);
     }
     let mut dive = None;
-    for c in children {
+    for c in step.children.clone() {
         let key = if P::ORDERED {
-            let child = tree
-                .node(c)
-                .ok_or(corrupt(side.letter(), NodeDefect::Missing))?;
-            let key = ordered_key(match side {
-                Side::A => policy.key(&child.bv, other_bv, b_to_a),
-                Side::B => policy.key(other_bv, &child.bv, b_to_a),
+            let child = step.child(c)?;
+            let key = ordered_key(match step.side {
+                Side::A => policy.key(&child.bv, step.other_bv, b_to_a),
+                Side::B => policy.key(step.other_bv, &child.bv, b_to_a),
             });
             if !policy.dive_into(key) {
                 stats.nodes_visited += 1;
@@ -529,11 +551,7 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
         } else {
             0.0
         };
-        let pair = match side {
-            Side::A => Pending::new(c, other, key),
-            Side::B => Pending::new(other, c, key),
-        };
-        dive = keep_smaller::<P, B>(dive, pair, waiting);
+        dive = keep_smaller::<P, B>(dive, step.pair(c, key), waiting);
     }
     Ok(dive)
 }
