@@ -38,9 +38,9 @@ pub(crate) trait Policy<B: BoundingVolume> {
     /// traversal stop at the first pruned smallest key; and a key once refused stays
     /// refused (the best answer only improves).
     fn keep(&self, key: f64) -> bool;
-    /// Whether an unordered traversal takes the children of a step nearest first (by the
-    /// distance between the centres of their enclosing balls and the other node's), rather
-    /// than in stored order: worth its cost when the query stops at its first find.
+    /// Whether an unordered traversal takes the two children of a step nearer first (by
+    /// the distance between their volumes' centres and the other node's), rather than in
+    /// stored order: worth its cost when the query stops at its first find.
     #[inline]
     fn nearest_first(&self) -> bool {
         false
@@ -427,24 +427,18 @@ impl<B: BoundingVolume> Step<'_, '_, B> {
     }
 }
 
-/// Puts the pairs of a step's two children on the stack nearer last, so that the nearer is
-/// taken first: the distance between the volumes' centres, a cheap guess at where contact
-/// is. (Wider nodes, of the variable encoding, go in stored order.)
+/// Puts the pairs of a step's two children (a binary tree's) on the stack nearer last, so
+/// that the nearer is taken first: the distance between the volumes' centres, a cheap
+/// guess at where contact is.
 #[inline(always)]
 fn push_nearest_last<B: BoundingVolume>(
     step: &Step<'_, '_, B>,
     b_to_a: &Pose,
     waiting: &mut impl Waiting,
 ) -> Result<(), QueryError> {
-    let (side, children) = (step.side, step.children.clone());
+    let side = step.side;
     let pair = |c: u32| step.pair(c, 0.0);
-    let (first, second) = (children.start, children.start.wrapping_add(1));
-    if children.len() != 2 {
-        for c in children {
-            waiting.put(pair(c));
-        }
-        return Ok(());
-    }
+    let (first, second) = (step.children.start, step.children.start.wrapping_add(1));
     // Centres in A's frame, where B's are mapped.
     let in_a = |bv: &B, of_b: bool| {
         let c = Vector3::from(bv.center());
@@ -459,7 +453,7 @@ fn push_nearest_last<B: BoundingVolume>(
         let child = step.child(c)?;
         Ok((in_a(&child.bv, side == Side::B) - other_centre).norm_squared())
     };
-    // (A NaN distance, from a damaged file, compares false: stored order.)
+    // (A NaN distance, from a damaged file, compares false: the first child first.)
     if distance(second)? < distance(first)? {
         waiting.put(pair(first));
         waiting.put(pair(second));
@@ -530,7 +524,8 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
     waiting: &mut impl Waiting,
     stats: &mut Stats,
 ) -> Result<Option<Pending>, QueryError> {
-    if !P::ORDERED && policy.nearest_first() {
+    // (Wider nodes, of the variable encoding, keep the order below.)
+    if !P::ORDERED && policy.nearest_first() && step.children.len() == 2 {
         push_nearest_last(step, b_to_a, waiting)?;
         return Ok(None);
     }
