@@ -62,7 +62,6 @@ fn build_info_verify_on_the_bundled_cow() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = obbtree(&["info", out.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&text.stdout).contains("5804"));
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -96,7 +95,6 @@ fn every_volume_precision_and_leaf_size_builds_and_verifies() {
             }
         }
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -107,7 +105,6 @@ fn two_builds_are_byte_identical() {
     assert!(
         std::fs::read(dir.join("a.obbt")).unwrap() == std::fs::read(dir.join("b.obbt")).unwrap()
     );
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -143,7 +140,6 @@ fn damaged_files_fail_with_one_line() {
     assert_bad_input(&obbtree(&["verify", damaged]), "truncated");
     // Not an .obbt file at all.
     assert_bad_input(&obbtree(&["info", &cow()]), "signature");
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -183,7 +179,6 @@ fn bad_input_is_exit_1_and_usage_errors_exit_2() {
         let o = obbtree(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -291,7 +286,6 @@ fn collide_distance_span_print_the_contract_fields() {
     for k in ["point_a", "point_b", "stats", "seconds"] {
         assert!(!s[k].is_null(), "span lacks {k}");
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -340,7 +334,6 @@ fn pose_batches_print_one_line_per_pose_in_order() {
         &obbtree(&["collide", f, f, "--poses", poses.to_str().unwrap()]),
         "poses.txt: line 3 (pose 1): expected 24 numbers",
     );
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -373,7 +366,6 @@ fn malformed_poses_and_mismatched_trees_are_exit_1() {
     let aabb = dir.join("aabb.obbt");
     build(&aabb, &["--bv", "aabb"]);
     assert_bad_input(&obbtree(&["span", f, aabb.to_str().unwrap()]), "differ");
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 // ---------------------------------------------------------------------------------------
@@ -402,7 +394,6 @@ fn build_never_overwrites_its_own_input() {
             assert_eq!(std::fs::read(&victim).unwrap(), original, "{output:?}");
         }
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -430,7 +421,6 @@ fn build_replaces_a_file_that_is_not_obbt_only_with_force() {
         &obbtree(&["build", &cow(), "-o", dir.to_str().unwrap(), "--force"]),
         "is a directory",
     );
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -446,7 +436,6 @@ fn unreadable_tree_inputs_get_the_readers_error() {
         &obbtree(&["info", dir.to_str().unwrap()]),
         "is a directory, not a .obbt file",
     );
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Runs `args`, reads `keep` lines of its standard output, closes the pipe, and returns
@@ -504,7 +493,6 @@ fn a_closed_pipe_ends_quietly() {
             .status
             .success());
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// The files of `dir` whose names contain `.tmp`.
@@ -589,7 +577,6 @@ fn an_interrupted_build_leaves_nothing_behind() {
         std::fs::remove_file(&out).unwrap();
     }
     assert!(caught, "never interrupted while writing");
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// A build killed outright (SIGKILL, a power cut) cannot clean up; the next build of the
@@ -609,7 +596,6 @@ fn a_build_removes_temporaries_of_a_killed_build() {
     build(&out, &[]);
     assert!(!stale.exists());
     assert!(other.exists() && live.exists());
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// One pose in every --pose-format gives the same answer; a rotation printed with 4
@@ -699,7 +685,6 @@ fn pose_formats_and_orthonormalize() {
         ]),
         "0 0 0 1",
     );
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Mesh-only flags are refused where they cannot apply; numbers and durations print as
@@ -746,7 +731,6 @@ fn flags_that_cannot_apply_and_readable_numbers() {
     let o = obbtree(&["demo"]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(!text.contains(" 0 us") && !text.contains(" 0 µs"), "{text}");
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Writes the bundled cow as an OBJ in `dir`, every vertex `p` written as `factor · p + shift`
@@ -881,7 +865,6 @@ fn scale_and_center_are_recorded_shown_and_queried_together() {
         &obbtree(&["verify", damaged.to_str().unwrap()]),
         "placement",
     );
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -904,7 +887,6 @@ fn bad_scales_are_exit_1_naming_the_flag() {
     // Not a number at all is a usage error, like any malformed value.
     let o = obbtree(&["build", &cow(), "-o", out, "--scale", "ten"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]

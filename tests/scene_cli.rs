@@ -203,7 +203,6 @@ fn a_good_scene_from_a_mesh_and_a_tree_runs() {
     assert_eq!(lines[0]["events"][0]["event"], "clearance_violated");
     assert_eq!(lines[1]["pairs"], lines[0]["pairs"]);
     assert_eq!(lines[2]["summary"]["reused"], 1);
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -265,7 +264,6 @@ fn bad_scenes_are_one_line_naming_file_line_and_field() {
         assert_bad_input(&o, needle);
         assert!(o.stdout.is_empty());
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -309,5 +307,4 @@ fn bad_frames_stop_at_their_line_after_printing_the_frames_before() {
         // The two frames before the bad line were printed.
         assert_eq!(json_lines(&o.stdout).len(), 2, "{needle}");
     }
-    std::fs::remove_dir_all(dir).unwrap();
 }
