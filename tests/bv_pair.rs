@@ -5,7 +5,7 @@ mod common;
 
 use common::oracle;
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use obbtree::bv::pair::{BoxPair, SAT_GUARD};
+use obbtree::bv::pair::{BoxPair, OFFSET_ROUNDING, SAT_GUARD};
 use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
 use obbtree::query::triangle::Triangle;
 use obbtree::query::Pose;
@@ -163,6 +163,27 @@ proptest! {
         // (Below about 1e-4 the guard's slack, 1e-6 of the boxes' size, takes its share.)
         if d > 1e-3 && !a.overlaps(&b, &b_to_a, 0.0) {
             prop_assert!(lb >= 2.0 / 3.0 * d, "lower bound {lb} below 2/3 of the distance {d}");
+        }
+    }
+
+    /// The overlap test is tight as well as conservative: boxes further apart than a
+    /// ten-thousandth of their size are reported disjoint (the guard and the slack widen
+    /// each box by about a millionth of the pair's size; the margin covers edge-edge axes
+    /// nearly parallel, where face axes must separate instead: 100,000 cases held at a
+    /// hundred-thousandth). A test made looser, its radii scaled up or an axis skipped,
+    /// shows here.
+    #[test]
+    fn boxes_apart_by_a_ten_thousandth_of_their_size_are_disjoint(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
+        let d = surface_distance(&a, &b, &b_to_a);
+        let size: f64 = a.half.iter().chain(&b.half).sum();
+        // Surfaces apart are boxes apart unless one box holds the other, and then it holds
+        // its corners.
+        let a_to_b = b_to_a.to_isometry().inverse();
+        let nested = corners(&b).iter().any(|q| a.contains(b_to_a.apply(q).into(), 0.0))
+            || corners(&a).iter().any(|p| b.contains((a_to_b * nalgebra::Point3::from(*p)).coords.into(), 0.0));
+        if d > 1e-4 * size && !nested {
+            prop_assert!(!a.overlaps(&b, &b_to_a, SAT_GUARD), "distance {d}, size {size}: reported overlapping");
+            prop_assert!(!a.overlaps(&b, &b_to_a, 0.0), "distance {d}, size {size}: overlapping unguarded");
         }
     }
 
@@ -367,6 +388,96 @@ fn thin_boxes_far_apart_are_bounded_along_the_centre_line() {
         assert!(
             lb >= gap - 0.01,
             "{far}: {lb} short of the centre-line gap {gap}"
+        );
+    }
+}
+
+/// A pair given in A's box frame: B's axes `m` (columns), centre `t`, half-widths.
+fn box_pair(m: Matrix3<f64>, t: [f64; 3], ha: [f64; 3], hb: [f64; 3], frame_error: f64) -> BoxPair {
+    BoxPair {
+        m,
+        t: Vector3::from(t),
+        ha: Vector3::from(ha),
+        hb: Vector3::from(hb),
+        frame_error,
+    }
+}
+
+/// Two zero-size boxes at one point (two triangles collapsed onto the same vertex at the
+/// origin, where rounding adds no slack): every projection and every radius is 0, and only
+/// the strict comparisons of the separating-axis test keep the pair touching.
+#[test]
+fn zero_size_boxes_at_one_point_touch() {
+    for m in [Matrix3::identity(), rotation(0.3, -1.1, 2.0)] {
+        let pair = box_pair(m, [0.0; 3], [0.0; 3], [0.0; 3], 0.0);
+        assert!(!pair.disjoint(0.0), "{m}");
+        assert!(!pair.disjoint(SAT_GUARD), "{m}");
+        assert_eq!(pair.distance_lower_bound(), 0.0);
+        assert_eq!(pair.max_distance(), 0.0);
+    }
+}
+
+/// Equal boxes at zero offset, turned or not: overlapping, no distance, and the largest
+/// distance is the diagonal.
+#[test]
+fn boxes_at_zero_offset_overlap() {
+    let h = [1.0, 2.0, 3.0];
+    for m in [Matrix3::identity(), rotation(0.3, -1.1, 2.0)] {
+        let pair = box_pair(m, [0.0; 3], h, h, 0.0);
+        assert!(!pair.disjoint(0.0));
+        assert_eq!(pair.distance_lower_bound(), 0.0);
+    }
+    let diagonal = 2.0 * 14f64.sqrt();
+    let same = box_pair(Matrix3::identity(), [0.0; 3], h, h, 0.0);
+    assert!((same.max_distance() - diagonal).abs() < 1e-12);
+}
+
+/// Where cubes of half-width `h` side by side along x (offset `y` across, frames `frame_error`
+/// from orthonormal) stop touching, by the documented slack: the face axis x has radii
+/// `2h + 3 guard h` (the guard on B's three rotation entries), and the slack adds
+/// `guard · 6h + (4 frame_error + OFFSET_ROUNDING) (x + y)`; no other axis is as short.
+fn cube_separation(h: f64, y: f64, frame_error: f64) -> f64 {
+    let k = 4.0 * frame_error + OFFSET_ROUNDING;
+    (2.0 * h + 3.0 * SAT_GUARD * h + 6.0 * SAT_GUARD * h + k * y) / (1.0 - k)
+}
+
+/// Boxes a billionth inside the slack touch and a billionth outside are apart: every term
+/// of [`BoxPair::slack`] is pinned (at these sizes dropping or shrinking any one moves the
+/// edge by far more), f64 frames and f32 frames alike.
+#[test]
+fn separation_is_reported_at_the_edge_of_the_slack() {
+    let (h, y) = (1e-3, 0.5e-3);
+    for frame_error in [0.0, 1e-10, 1e-6] {
+        let edge = cube_separation(h, y, frame_error);
+        for (scale, apart) in [(1.0 - 1e-9, false), (1.0 + 1e-9, true)] {
+            let pair = box_pair(
+                Matrix3::identity(),
+                [edge * scale, y, 0.0],
+                [h; 3],
+                [h; 3],
+                frame_error,
+            );
+            assert_eq!(
+                pair.disjoint(SAT_GUARD),
+                apart,
+                "frame error {frame_error}, offset {scale} of the edge"
+            );
+        }
+    }
+    // Stored f32 boxes get the f32 frame tolerance, 1e-6, whatever their axes.
+    let hf = 1e-3f32;
+    let cube = Obb::<f32> {
+        axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        center: [0.0; 3],
+        half: [hf; 3],
+    };
+    let edge = cube_separation(f64::from(hf), y, 1e-6);
+    for (scale, apart) in [(1.0 - 1e-9, false), (1.0 + 1e-9, true)] {
+        let pose = Pose::translation(edge * scale, y, 0.0);
+        assert_eq!(
+            !cube.overlaps(&cube, &pose, SAT_GUARD),
+            apart,
+            "f32, {scale} of the edge"
         );
     }
 }

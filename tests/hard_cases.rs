@@ -500,6 +500,18 @@ fn zero_area_triangles_touch_by_their_point_or_segment() {
             expect,
         );
     }
+    // Two points at the origin: zero-size boxes (no rounding slack at the origin) at zero
+    // offset, where only the strict comparisons of the separating-axis test report the
+    // contact (each `>` made `>=` calls every axis separating).
+    let origin = [0.0; 3];
+    check_scene(
+        "point on point at the origin",
+        &one_triangle(origin, origin, origin),
+        &Pose::identity(),
+        &one_triangle(origin, origin, origin),
+        &Pose::identity(),
+        Expect::Contact,
+    );
     // A segment (collinear corners) crossing A's edge in A's plane, and one crossing the
     // plane through A's interior, and one skew to it above.
     for (name, p, q, expect) in [
