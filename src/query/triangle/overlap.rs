@@ -398,15 +398,115 @@ pub(crate) fn point_in_tri_2d(p: P2, t: &[P2; 3]) -> bool {
 mod tests {
     use super::*;
 
+    /// Every way of writing the same two segments: either end first, either segment first.
+    fn seg_seg_2d_all_orders(p: P2, q: P2, r: P2, s: P2) -> [bool; 8] {
+        [
+            seg_seg_2d(p, q, r, s),
+            seg_seg_2d(q, p, r, s),
+            seg_seg_2d(p, q, s, r),
+            seg_seg_2d(q, p, s, r),
+            seg_seg_2d(r, s, p, q),
+            seg_seg_2d(s, r, p, q),
+            seg_seg_2d(r, s, q, p),
+            seg_seg_2d(s, r, q, p),
+        ]
+    }
+
     #[test]
     fn seg_seg_2d_cases() {
-        assert!(seg_seg_2d([0., 0.], [2., 2.], [0., 2.], [2., 0.]));
-        assert!(seg_seg_2d([0., 0.], [1., 1.], [1., 1.], [2., 0.]));
-        assert!(!seg_seg_2d([0., 0.], [1., 1.], [2., 2.], [3., 3.]));
-        assert!(seg_seg_2d([0., 0.], [2., 2.], [1., 1.], [3., 3.]));
-        assert!(seg_seg_2d([1., 1.], [1., 1.], [0., 0.], [2., 2.]));
-        assert!(!seg_seg_2d([1., 1.], [1., 1.], [2., 2.], [2., 2.]));
-        assert!(seg_seg_2d([1., 1.], [1., 1.], [1., 1.], [1., 1.]));
+        let cases = [
+            ([0., 0.], [2., 2.], [0., 2.], [2., 0.], true), // crossing
+            ([0., 0.], [1., 1.], [1., 1.], [2., 0.], true), // sharing an end
+            ([0., 0.], [2., 0.], [1., 0.], [1., 3.], true), // an end on the other's interior
+            ([0., 0.], [2., 0.], [1., 1e-300], [1., 3.], false), // that end just off it
+            ([0., 0.], [1., 1.], [2., 2.], [3., 3.], false), // collinear, apart
+            ([0., 0.], [2., 2.], [1., 1.], [3., 3.], true), // collinear, overlapping
+            ([0., 0.], [1., 1.], [1., 1.], [3., 3.], true), // collinear, touching at an end
+            ([0., 0.], [1., 0.], [2., 0.], [3., 0.], false), // horizontal, apart
+            ([0., 0.], [0., 1.], [0., 2.], [0., 3.], false), // vertical, apart
+            ([0., 0.], [1., 0.], [0., 1.], [1., 1.], false), // parallel
+            ([1., 1.], [1., 1.], [0., 0.], [2., 2.], true), // a point on a segment
+            ([1., 1.], [1., 1.], [0., 0.], [2., 2.1], false), // a point beside it
+            ([1., 1.], [1., 1.], [2., 2.], [2., 2.], false), // two points apart
+            ([1., 1.], [1., 1.], [1., 1.], [1., 1.], true), // two points together
+        ];
+        for (p, q, r, s, meet) in cases {
+            assert_eq!(
+                seg_seg_2d_all_orders(p, q, r, s),
+                [meet; 8],
+                "{p:?}-{q:?} and {r:?}-{s:?}"
+            );
+        }
+    }
+
+    /// A triangle's three cyclic orders, counter-clockwise and clockwise: six ways of
+    /// writing one closed triangle, so every edge takes every place in the predicates.
+    fn windings(t: [P2; 3]) -> [[P2; 3]; 6] {
+        let [a, b, c] = t;
+        [
+            [a, b, c],
+            [b, c, a],
+            [c, a, b],
+            [a, c, b],
+            [c, b, a],
+            [b, a, c],
+        ]
+    }
+
+    #[test]
+    fn point_in_tri_2d_takes_either_winding_and_the_whole_boundary() {
+        let t = [[0., 0.], [4., 0.], [0., 4.]];
+        let inside = [
+            [1., 1.],
+            [2., 2.],
+            [2., 0.],
+            [0., 2.],
+            [0., 0.],
+            [4., 0.],
+            [0., 4.],
+        ];
+        let outside = [
+            [2.5, 2.],
+            [-0.5, 1.],
+            [1., -0.5],
+            [5., 0.],
+            [-1., -1.],
+            [0., 4.5],
+        ];
+        for w in windings(t) {
+            for p in inside {
+                assert!(point_in_tri_2d(p, &w), "{p:?} in {w:?}");
+            }
+            for p in outside {
+                assert!(!point_in_tri_2d(p, &w), "{p:?} not in {w:?}");
+            }
+        }
+        // A degenerate triangle holds nothing by itself (its edges are tested instead).
+        for w in windings([[0., 0.], [1., 1.], [2., 2.]]) {
+            assert!(!point_in_tri_2d([1., 1.], &w));
+        }
+    }
+
+    #[test]
+    fn tri_tri_2d_takes_either_winding() {
+        let t = [[0., 0.], [4., 0.], [0., 4.]];
+        let cases = [
+            ([[1., 1.], [2., 1.], [1., 2.]], true), // inside, no edge contact
+            ([[-1., -1.], [9., -1.], [-1., 9.]], true), // around it
+            ([[2., 2.], [5., 5.], [2., 5.]], true), // a corner on the hypotenuse
+            ([[4., 0.], [5., 0.], [5., 1.]], true), // sharing a corner
+            ([[3., 3.], [5., 5.], [3., 5.]], false), // beyond the hypotenuse
+            ([[1., 1.], [1., 1.], [1., 1.]], true), // a point inside
+            ([[5., 5.], [5., 5.], [5., 5.]], false), // a point outside
+        ];
+        for (u, meet) in cases {
+            for wt in windings(t) {
+                for wu in windings(u) {
+                    assert_eq!(tri_tri_2d(&wt, &wu), meet, "{wt:?} and {wu:?}");
+                    assert_eq!(tri_tri_2d(&wu, &wt), meet, "{wu:?} and {wt:?}");
+                }
+            }
+        }
     }
 
     #[test]
