@@ -2,7 +2,7 @@
 
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangles_intersect, Triangle};
-use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
+use super::{source_id, with_views, DescentRule, Pose, QueryError, Side, Stats};
 use crate::bv::pair::{OFFSET_ROUNDING, SAT_GUARD};
 use crate::bv::BoundingVolume;
 use crate::format::ObbtFile;
@@ -145,7 +145,7 @@ pub fn collide_into<B: BoundingVolume>(
     for &(fa, fb) in &context.faces {
         result
             .pairs
-            .push((source_id(a, fa, 'A')?, source_id(b, fb, 'B')?));
+            .push((source_id(a, fa, Side::A)?, source_id(b, fb, Side::B)?));
     }
     result.pairs.sort_unstable();
     result.colliding = !result.pairs.is_empty();

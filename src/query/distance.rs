@@ -3,7 +3,7 @@
 
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangle_distance, Triangle};
-use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
+use super::{source_id, with_views, DescentRule, Pose, QueryError, Side, Stats};
 use crate::bv::BoundingVolume;
 use crate::format::ObbtFile;
 use crate::tree::TreeView;
@@ -281,8 +281,8 @@ fn run<B: BoundingVolume>(
         distance: best.distance,
         point_a: pose_a.apply(&best.point_a),
         point_b: pose_a.apply(&best.point_b),
-        tri_a: source_id(a, faces.0, 'A')?,
-        tri_b: source_id(b, faces.1, 'B')?,
+        tri_a: source_id(a, faces.0, Side::A)?,
+        tri_b: source_id(b, faces.1, Side::B)?,
         witness: Witness {
             face_a: faces.0,
             face_b: faces.1,
@@ -324,7 +324,7 @@ pub fn distance<B: BoundingVolume>(
     let (result, _) = run(a, pose_a, b, pose_b, policy, options.rule, warm, context)?;
     // Every tree has a face, so some triangle pair was measured unless the tree is corrupt.
     result.ok_or(QueryError::CorruptTree {
-        which: 'A',
+        which: Side::A,
         what: "no triangle pair reached",
     })
 }

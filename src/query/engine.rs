@@ -10,7 +10,7 @@
 use super::descent::DescentRule;
 use super::stats::Stats;
 use super::triangle::Triangle;
-use super::QueryError;
+use super::{QueryError, Side};
 use crate::bv::{BoundingVolume, Node};
 use crate::pose::Pose;
 use crate::tree::{NodeDefect, NodeKind, TreeView};
@@ -221,7 +221,7 @@ fn triangle<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     face: u32,
     b_to_a: Option<&Pose>,
-    which: char,
+    which: Side,
 ) -> Result<Triangle, QueryError> {
     let t = tree.triangle(face).ok_or(QueryError::CorruptTree {
         which,
@@ -263,7 +263,7 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
         frontier.heap.clear();
         frontier.overflow.clear();
         let (Some(ra), Some(rb)) = (a.node(0), b.node(0)) else {
-            return Err(corrupt('A', NodeDefect::Missing));
+            return Err(corrupt(Side::A, NodeDefect::Missing));
         };
         let key = ordered_key(policy.key(&ra.bv, &rb.bv, b_to_a));
         frontier.put(Pending::new(0, 0, key));
@@ -276,7 +276,7 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     }
 }
 
-fn corrupt(which: char, defect: NodeDefect) -> QueryError {
+fn corrupt(which: Side, defect: NodeDefect) -> QueryError {
     QueryError::CorruptTree {
         which,
         what: defect.describe(),
@@ -322,12 +322,12 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
         stats.nodes_visited += 1;
         if stats.nodes_visited > limit {
             return Err(QueryError::CorruptTree {
-                which: 'A',
+                which: Side::A,
                 what: "a node is reachable along two paths",
             });
         }
-        let na = a.node(ia).ok_or(corrupt('A', NodeDefect::Missing))?;
-        let nb = b.node(ib).ok_or(corrupt('B', NodeDefect::Missing))?;
+        let na = a.node(ia).ok_or(corrupt(Side::A, NodeDefect::Missing))?;
+        let nb = b.node(ib).ok_or(corrupt(Side::B, NodeDefect::Missing))?;
         let key = if P::ORDERED {
             key
         } else {
@@ -351,15 +351,15 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
             continue;
         }
         stats.bv_overlap += 1;
-        let kind_a = a.node_kind(ia).map_err(|d| corrupt('A', d))?;
-        let kind_b = b.node_kind(ib).map_err(|d| corrupt('B', d))?;
+        let kind_a = a.node_kind(ia).map_err(|d| corrupt(Side::A, d))?;
+        let kind_b = b.node_kind(ib).map_err(|d| corrupt(Side::B, d))?;
         // The tree a step descends, and its node's children.
         let (side, children) = match (kind_a, kind_b) {
             (NodeKind::Faces(faces_a), NodeKind::Faces(faces_b)) => {
                 for fa in faces_a {
-                    let ta = triangle(a, fa, None, 'A')?;
+                    let ta = triangle(a, fa, None, Side::A)?;
                     for fb in faces_b.clone() {
-                        let tb = triangle(b, fb, Some(b_to_a), 'B')?;
+                        let tb = triangle(b, fb, Some(b_to_a), Side::B)?;
                         if policy.triangles(fa, &ta, fb, &tb, &mut stats) == Flow::Stop {
                             return Ok(stats);
                         }
@@ -423,7 +423,7 @@ impl<B: BoundingVolume> Step<'_, '_, B> {
     fn child(&self, c: u32) -> Result<&Node<B>, QueryError> {
         self.tree
             .node(c)
-            .ok_or(corrupt(self.side.letter(), NodeDefect::Missing))
+            .ok_or(corrupt(self.side, NodeDefect::Missing))
     }
 }
 
@@ -488,23 +488,6 @@ fn keep_smaller<P: Policy<B>, B: BoundingVolume>(
             Some(pair)
         }
         None => Some(pair),
-    }
-}
-
-/// Which tree a step descends.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Side {
-    A,
-    B,
-}
-
-impl Side {
-    /// The tree's letter in errors.
-    fn letter(self) -> char {
-        match self {
-            Side::A => 'A',
-            Side::B => 'B',
-        }
     }
 }
 

@@ -43,6 +43,24 @@ use crate::format::ObbtFile;
 use crate::real::Precision;
 use crate::tree::TreeView;
 
+/// One of the two models of a pair query: A, in whose frame results are given, or B.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// The first model.
+    A,
+    /// The second model.
+    B,
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Side::A => "A",
+            Side::B => "B",
+        })
+    }
+}
+
 /// Why a query could not answer.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -58,8 +76,8 @@ pub enum QueryError {
     /// A tree's contents are inconsistent (an unverified, corrupt file).
     #[error("tree {which} is corrupt: {what} (run `obbtree verify`)")]
     CorruptTree {
-        /// 'A' or 'B'.
-        which: char,
+        /// The model whose tree it is.
+        which: Side,
         /// What was found.
         what: &'static str,
     },
@@ -166,7 +184,7 @@ pub(crate) use with_views;
 pub(crate) fn source_id<B: crate::bv::BoundingVolume>(
     tree: &crate::tree::TreeView<'_, B>,
     face: u32,
-    which: char,
+    which: Side,
 ) -> Result<u32, QueryError> {
     tree.source_id(face).ok_or(QueryError::CorruptTree {
         which,

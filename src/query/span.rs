@@ -2,7 +2,7 @@
 
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangle_max_distance, Triangle};
-use super::{source_id, with_views, DescentRule, Pose, QueryError, Stats};
+use super::{source_id, with_views, DescentRule, Pose, QueryError, Side, Stats};
 use crate::bv::BoundingVolume;
 use crate::format::ObbtFile;
 use crate::tree::TreeView;
@@ -88,7 +88,7 @@ pub fn span<B: BoundingVolume>(
     let stats = traverse(a, b, &b_to_a, rule, &mut policy, context)?;
     if policy.best < 0.0 {
         return Err(QueryError::CorruptTree {
-            which: 'A',
+            which: Side::A,
             what: "no triangle pair reached",
         });
     }
@@ -96,8 +96,8 @@ pub fn span<B: BoundingVolume>(
         span: policy.best,
         point_a: pose_a.apply(&policy.point_a),
         point_b: pose_a.apply(&policy.point_b),
-        tri_a: source_id(a, policy.faces.0, 'A')?,
-        tri_b: source_id(b, policy.faces.1, 'B')?,
+        tri_a: source_id(a, policy.faces.0, Side::A)?,
+        tri_b: source_id(b, policy.faces.1, Side::B)?,
         stats,
     })
 }

@@ -11,7 +11,7 @@ use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::query::{
     collide, distance, distance_below, span, with_views, within_tolerance, CollideOptions,
-    DescentRule, DistanceOptions, Pose, QueryContext, QueryError, Stats, Witness,
+    DescentRule, DistanceOptions, Pose, QueryContext, QueryError, Side, Stats, Witness,
 };
 use crate::tree::TreeView;
 use rayon::prelude::*;
@@ -640,7 +640,7 @@ fn run_job(
     context: &mut QueryContext,
 ) -> Result<Outcome, QueryError> {
     let missing = QueryError::CorruptTree {
-        which: 'A',
+        which: Side::A,
         what: "no such object",
     };
     let (Some(a), Some(b)) = (
