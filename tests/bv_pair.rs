@@ -432,6 +432,23 @@ fn boxes_at_zero_offset_overlap() {
     assert!((same.max_distance() - diagonal).abs() < 1e-12);
 }
 
+/// Unit cubes side by side with a gap of 1 along x: the lower bound (the box pair's own,
+/// as the volumes' is) is the gap less the slack, exactly.
+#[test]
+fn cubes_side_by_side_have_their_gap_as_lower_bound() {
+    let pair = box_pair(
+        Matrix3::identity(),
+        [3.0, 0.0, 0.0],
+        [1.0; 3],
+        [1.0; 3],
+        0.0,
+    );
+    let expected = 1.0 - pair.slack(SAT_GUARD);
+    assert!((pair.distance_lower_bound() - expected).abs() < 1e-12);
+    assert!((pair.distance_lower_bound_until(0.5) - expected).abs() < 1e-12);
+    assert!(pair.disjoint(SAT_GUARD));
+}
+
 /// Where cubes of half-width `h` side by side along x (offset `y` across, frames `frame_error`
 /// from orthonormal) stop touching, by the documented slack: the face axis x has radii
 /// `2h + 3 guard h` (the guard on B's three rotation entries), and the slack adds

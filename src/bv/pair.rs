@@ -393,3 +393,28 @@ macro_rules! box_pair_methods {
     };
 }
 pub(crate) use box_pair_methods;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two sticks along x, B turned by 1e-8 about z (so that `m₀₀` rounds to exactly 1
+    /// while `m₁₀` does not vanish) and 1000 above A: the edge axis `a₀ × b₀` has length 0
+    /// in f64 but a positive gap, which divided by that length would be an infinite
+    /// "lower bound". Such axes are skipped; what is left is no more than the distance.
+    #[test]
+    fn edge_axes_of_nearly_parallel_edges_are_skipped() {
+        let angle: f64 = 1e-8;
+        let (c, s) = (angle.cos(), angle.sin());
+        assert_eq!(c, 1.0);
+        let pair = BoxPair {
+            m: Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+            t: Vector3::new(0.0, 0.0, 1000.0),
+            ha: Vector3::new(1.0, 0.0, 0.0),
+            hb: Vector3::new(1.0, 0.0, 0.0),
+            frame_error: 0.0,
+        };
+        let gap = pair.edge_axis_gap(&pair.m.abs(), pair.slack(SAT_GUARD));
+        assert!(gap.is_finite() && gap <= 1000.0, "{gap}");
+    }
+}
