@@ -414,6 +414,8 @@ fn zero_size_boxes_at_one_point_touch() {
         assert!(!pair.disjoint(SAT_GUARD), "{m}");
         assert_eq!(pair.distance_lower_bound(), 0.0);
         assert_eq!(pair.max_distance(), 0.0);
+        // The alternating projections meet: no direction, and no gap along it.
+        assert_eq!(pair.closest_direction_gap(), (0.0, 0.0));
     }
 }
 
@@ -426,6 +428,7 @@ fn boxes_at_zero_offset_overlap() {
         let pair = box_pair(m, [0.0; 3], h, h, 0.0);
         assert!(!pair.disjoint(0.0));
         assert_eq!(pair.distance_lower_bound(), 0.0);
+        assert_eq!(pair.closest_direction_gap(), (0.0, 0.0));
     }
     let diagonal = 2.0 * 14f64.sqrt();
     let same = box_pair(Matrix3::identity(), [0.0; 3], h, h, 0.0);
