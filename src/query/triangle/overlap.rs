@@ -398,6 +398,30 @@ pub(crate) fn point_in_tri_2d(p: P2, t: &[P2; 3]) -> bool {
 mod tests {
     use super::*;
 
+    /// The pre-filter of every triangle pair: boxes apart on any one axis, in either order,
+    /// reject the pair (a filter that never rejects would leave every answer right and
+    /// only cost time); closed boxes that touch do not.
+    #[test]
+    fn aabb_overlap_rejects_triangles_apart_on_any_axis() {
+        let a: Triangle = [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.0, 1.0, 1.0),
+        ];
+        let moved = |k: usize, by: f64| a.map(|p| p + Vector3::ith(k, by));
+        for k in 0..3 {
+            for by in [-1.5, 1.5] {
+                assert!(!aabb_overlap(&a, &moved(k, by)), "axis {k} by {by}");
+                assert!(
+                    !aabb_overlap(&moved(k, by), &a),
+                    "axis {k} by {by}, swapped"
+                );
+            }
+            assert!(aabb_overlap(&a, &moved(k, 1.0)), "axis {k}: touching");
+            assert!(aabb_overlap(&a, &moved(k, 0.5)), "axis {k}: overlapping");
+        }
+    }
+
     /// Every way of writing the same two segments: either end first, either segment first.
     fn seg_seg_2d_all_orders(p: P2, q: P2, r: P2, s: P2) -> [bool; 8] {
         [
