@@ -269,8 +269,8 @@ fn special_cases(
         (true, false) => line_crosses_triangle(b, db, a),
         // Both degenerate: segments or points.
         (true, true) => degenerate_pair(a, b),
-        // Excluded by the caller; answer exactly all the same.
-        (false, false) => coplanar(a, b) || guigue_devillers(a, b, *da, *db),
+        // Excluded by the caller: the general case, exact all the same.
+        (false, false) => guigue_devillers(a, b, *da, *db),
     }
 }
 
@@ -420,6 +420,23 @@ mod tests {
             assert!(aabb_overlap(&a, &moved(k, 1.0)), "axis {k}: touching");
             assert!(aabb_overlap(&a, &moved(k, 0.5)), "axis {k}: overlapping");
         }
+    }
+
+    /// The coplanar fallback of the orientation dispatch decides by projection: triangles
+    /// of one plane overlapping, touching at a corner, and apart.
+    #[test]
+    fn coplanar_pairs_are_decided_in_their_plane() {
+        let tri = |p: [f64; 3], q: [f64; 3], r: [f64; 3]| -> Triangle {
+            [Vector3::from(p), Vector3::from(q), Vector3::from(r)]
+        };
+        // The plane x + y + z = 1, so that no coordinate plane holds it.
+        let a = tri([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        let inner = tri([0.5, 0.25, 0.25], [0.25, 0.5, 0.25], [0.25, 0.25, 0.5]);
+        let corner = tri([1.0, 0.0, 0.0], [2.0, -1.0, 0.0], [2.0, 0.0, -1.0]);
+        let apart = tri([2.0, -1.0, 0.0], [3.0, -1.0, -1.0], [2.0, 0.0, -1.0]);
+        assert!(coplanar(&a, &inner) && coplanar(&inner, &a));
+        assert!(coplanar(&a, &corner) && coplanar(&corner, &a));
+        assert!(!coplanar(&a, &apart) && !coplanar(&apart, &a));
     }
 
     /// Every way of writing the same two segments: either end first, either segment first.
