@@ -67,16 +67,15 @@ fn distance_work_on_the_cow_is_pinned() {
     // Before pairs pruned when keyed were dropped at once (and counted: at a touching pose
     // the traversal stops with pairs still waiting, which were not counted) and dives
     // took 0.7 of rel_err rather than half: exact (55,160, 3,607), rel_err 0.01
-    // (25,140, 617). With the hull only on nodes of 512 faces or more (2048 since):
-    // exact (47,661, 3,492), rel_err 0.01 (19,644, 505).
+    // (25,140, 617).
     assert_eq!(
         total(&exact),
-        (47_169, 3_478),
+        (47_661, 3_492),
         "exact: node pairs, triangle pairs"
     );
     assert_eq!(
         total(&rel),
-        (19_556, 513),
+        (19_644, 505),
         "rel_err 0.01: node pairs, triangle pairs"
     );
 }

@@ -83,18 +83,12 @@ impl Default for BuildOptions {
 /// The default [`BuildOptions::hull_min_faces`]. The hull fit earns its cost on large nodes,
 /// whose triangles sample the shape unevenly or hide detail inside it (§3.4); on a small
 /// patch of surface its hull adds phantom faces across every concavity, and the triangles'
-/// own covariance gives boxes as tight or tighter. Measured with `examples/tree_work` on the
-/// bunny, fandisk, pig, cow and a 40k lat/long sphere against a turned copy (40 poses
-/// each): at 512, every mesh's trees made 0.8 to 6.8% fewer box tests in all-pairs
-/// collision than with the hull at every node, and a one-thread build took 35 to 40% less
-/// time. Once boxes on the model's axes replaced fitted ones where smaller, 2048 did as
-/// well again on those and on lat/long spheres of 1.6k and 10k triangles: all-pairs box
-/// tests −2.3…+0.4% against 512's, distance node pairs −5.3…+2.2%, first contact
-/// −6.2…+21% (the spheres lose, 1,812 → 2,194 pairs on the smallest; the bunny gains),
-/// for 20% fewer build instructions on the 40k sphere and 9% on the bunny (callgrind). At
-/// 4096 the cow, whose root alone is then fitted to its hull, visited 2.6% more pairs in
-/// distance and 6% in first contact.
-pub const DEFAULT_HULL_MIN_FACES: u32 = 2048;
+/// own covariance gives boxes as tight or tighter. Measured on the bunny, fandisk, pig, cow
+/// and a 40k lat/long sphere against a turned copy (40 poses each): at 512 every mesh's
+/// trees made 0.8 to 6.8% fewer box tests in all-pairs collision than with the hull at every
+/// node, and distance queries visited up to 11% fewer node pairs (the sphere 1% more),
+/// while a one-thread build took 35 to 40% less time.
+pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
 
 /// The default [`BuildOptions::hull_max_points`]. The top levels of a tree hold most of the
 /// remaining hull work, all the more on convex shapes, whose every vertex is a hull vertex;

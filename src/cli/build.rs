@@ -82,7 +82,7 @@ pub struct TreeArgs {
     /// convex hull; smaller nodes are fitted to their triangles, which is as tight there
     /// and much cheaper. 1 fits every node to its hull (over every vertex too with
     /// --hull-max-points all and --model-axes no: the dissertation's §3.4 exactly)
-    /// [default: 2048].
+    /// [default: 512].
     #[arg(long, value_name = "N")]
     pub hull_min_faces: Option<u32>,
     /// With --fit hull, the most vertices (at least 4) a node's hull is computed over:
