@@ -87,7 +87,9 @@ impl Default for BuildOptions {
 /// and a 40k lat/long sphere against a turned copy (40 poses each): at 512 every mesh's
 /// trees made 0.8 to 6.8% fewer box tests in all-pairs collision than with the hull at every
 /// node, and distance queries visited up to 11% fewer node pairs (the sphere 1% more),
-/// while a one-thread build took 35 to 40% less time.
+/// while a one-thread build took 35 to 40% less time. 2048 built 12% faster against RAPID
+/// with as few box tests, but made `rel_err` and touching distance queries 6 and 12%
+/// slower against PQP in the same runs (README, "tried and not kept").
 pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
 
 /// The default [`BuildOptions::hull_max_points`]. The top levels of a tree hold most of the
