@@ -6,7 +6,6 @@
 
 mod common;
 
-use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
 use obbtree::query::{CollideOptions, PairQuery, Pose};
 
@@ -17,10 +16,8 @@ fn first_contact_work_on_the_cow_is_pinned() {
     let here = Pose::identity();
     let (mut nodes, mut touching) = (0u64, 0u32);
     for k in 0..30u64 {
-        let rotation = common::rng::seeded_rotation(k + 1);
-        let direction = common::rng::seeded_rotation(k + 101) * Vector3::x();
         let scale = [0.1, 0.2, 0.3, 0.4, 0.5][(k % 5) as usize];
-        let pose = Pose::new(rotation, direction * scale).expect("a rotation");
+        let pose = common::turned_pose(k + 1, scale);
         let (found, stats) = pair
             .first_contact_stats(&here, &pose)
             .expect("first contact");

@@ -5,7 +5,6 @@
 
 mod common;
 
-use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
 use obbtree::query::{DistanceOptions, PairQuery, Pose, Stats};
 
@@ -14,10 +13,8 @@ use obbtree::query::{DistanceOptions, PairQuery, Pose, Stats};
 fn poses() -> Vec<Pose> {
     (0..30u64)
         .map(|k| {
-            let rotation = common::rng::seeded_rotation(k + 1);
-            let direction = common::rng::seeded_rotation(k + 101) * Vector3::x();
             let scale = [0.6, 1.0, 1.5, 2.5, 4.0][(k % 5) as usize];
-            Pose::new(rotation, direction * scale).expect("a rotation")
+            common::turned_pose(k + 1, scale)
         })
         .collect()
 }

@@ -181,30 +181,28 @@ fn concentric_cases() -> Vec<Case> {
         .collect()
 }
 
-/// The cow against a copy turned at random and moved by `scale` along a random direction.
-fn cow_pose(seed: u64, scale: f64) -> Pose {
-    let rotation = common::rng::seeded_rotation(seed);
-    let direction = common::rng::seeded_rotation(seed + 100) * Vector3::x();
-    Pose::new(rotation, direction * scale).expect("rotation")
-}
-
 fn cow_cases() -> Vec<Case> {
     vec![
         Case {
             name: "cow all pairs".into(),
             run: Box::new(|pair| {
                 let options = CollideOptions::default();
-                pair.collide(&Pose::identity(), &cow_pose(3, 0.3), &options)
+                pair.collide(&Pose::identity(), &common::turned_pose(3, 0.3), &options)
                     .expect("collide")
                     .stats
             }),
             complete: true,
         },
-        first_contact("cow first contact".into(), cow_pose(3, 0.3)),
-        distance("cow distance rel_err=0".into(), cow_pose(4, 1.5), 0.0, true),
+        first_contact("cow first contact".into(), common::turned_pose(3, 0.3)),
+        distance(
+            "cow distance rel_err=0".into(),
+            common::turned_pose(4, 1.5),
+            0.0,
+            true,
+        ),
         distance(
             "cow distance rel_err=0.01".into(),
-            cow_pose(4, 1.5),
+            common::turned_pose(4, 1.5),
             0.01,
             true,
         ),

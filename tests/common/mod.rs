@@ -223,6 +223,13 @@ pub fn sliding_pose(x: f64, seed: u64) -> obbtree::query::Pose {
     .expect("rotation")
 }
 
+/// A model's copy turned by the seeded rotation `seed` and moved by `scale` along the x
+/// axis turned by the rotation `seed + 100`: the poses of the pinned-work tests.
+pub fn turned_pose(seed: u64, scale: f64) -> obbtree::query::Pose {
+    let direction = rng::seeded_rotation(seed + 100) * nalgebra::Vector3::x();
+    obbtree::query::Pose::new(rng::seeded_rotation(seed), direction * scale).expect("rotation")
+}
+
 /// The default tree of `mesh` in f64 (the scenes compare against f64 brute force).
 pub fn tree_f64(mesh: &TriMesh) -> obbtree::format::ObbtFile {
     let options = obbtree::build::BuildOptions {
