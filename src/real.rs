@@ -91,8 +91,9 @@ pub trait Real:
     fn from_f64_down(x: f64) -> Self;
     /// Exact widening to f64.
     fn to_f64(self) -> f64;
-    /// Appends the little-endian encoding.
-    fn write_le(self, out: &mut Vec<u8>);
+    /// Writes the little-endian encoding into the first `size_of::<Self>()` bytes of `out`
+    /// (fewer if `out` is shorter).
+    fn write_le(self, out: &mut [u8]);
 }
 
 impl Real for f32 {
@@ -101,27 +102,23 @@ impl Real for f32 {
     fn from_f64_nearest(x: f64) -> f32 {
         x as f32
     }
+    // Whether rounding went the wrong way is a coin toss: selects, not branches (a
+    // mispredicted branch here cost more than the rest of enclosing a leaf).
     fn from_f64_up(x: f64) -> f32 {
         let r = x as f32;
-        if f64::from(r) < x {
-            r.next_up()
-        } else {
-            r
-        }
+        std::hint::select_unpredictable(f64::from(r) < x, r.next_up(), r)
     }
     fn from_f64_down(x: f64) -> f32 {
         let r = x as f32;
-        if f64::from(r) > x {
-            r.next_down()
-        } else {
-            r
-        }
+        std::hint::select_unpredictable(f64::from(r) > x, r.next_down(), r)
     }
     fn to_f64(self) -> f64 {
         f64::from(self)
     }
-    fn write_le(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
+    fn write_le(self, out: &mut [u8]) {
+        for (o, b) in out.iter_mut().zip(self.to_le_bytes()) {
+            *o = b;
+        }
     }
 }
 
@@ -140,8 +137,10 @@ impl Real for f64 {
     fn to_f64(self) -> f64 {
         self
     }
-    fn write_le(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
+    fn write_le(self, out: &mut [u8]) {
+        for (o, b) in out.iter_mut().zip(self.to_le_bytes()) {
+            *o = b;
+        }
     }
 }
 

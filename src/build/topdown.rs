@@ -7,7 +7,7 @@
 
 use super::BuildOptions;
 use crate::bv::BoundingVolume;
-use crate::fit::{model_axes_frame, principal_axes, principal_axes_and_vertices, FitMethod};
+use crate::fit::{principal_axes, principal_axes_and_vertices, FitMethod};
 use crate::format::NodeRun;
 use crate::stats::TreeShape;
 use crate::tree::{Draft, NodeRef};
@@ -249,18 +249,20 @@ fn fit_and_split<B: BoundingVolume>(
         faces,
         &mut scratch.vertices,
     );
-    let fitted = B::enclose_vertices(&axes, ctx.positions, &scratch.vertices);
     let (axes, bv) = if ctx.options.model_axes {
-        let model = model_axes_frame(ctx.positions, &scratch.vertices);
-        let aligned = B::enclose_vertices(&model, ctx.positions, &scratch.vertices);
+        let [fitted, aligned] =
+            B::enclose_vertices_fitted_and_aligned(&axes, ctx.positions, &scratch.vertices);
         // The fitted frame wins ties.
-        if aligned.volume() < fitted.volume() {
-            (model, aligned)
+        if aligned.1.volume() < fitted.1.volume() {
+            aligned
         } else {
-            (axes, fitted)
+            fitted
         }
     } else {
-        (axes, fitted)
+        (
+            axes,
+            B::enclose_vertices(&axes, ctx.positions, &scratch.vertices),
+        )
     };
     if faces.len() <= ctx.options.leaf_size as usize {
         if let Some(p) = ctx.progress {

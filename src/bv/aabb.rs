@@ -86,9 +86,12 @@ impl<R: Real> BoundingVolume for Aabb<R> {
         Self::enclose_points(listed_vertices(positions, vertices))
     }
 
-    fn write_le(&self, out: &mut Vec<u8>) {
-        for v in self.min.iter().chain(&self.max) {
-            v.write_le(out);
+    fn write_le(&self, out: &mut [u8]) {
+        let (lo, hi) = (self.min, self.max);
+        // An array rather than chained iterators: the loop then unrolls into plain stores.
+        let scalars = [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]];
+        for (o, v) in out.chunks_exact_mut(size_of::<R>()).zip(scalars) {
+            v.write_le(o);
         }
     }
 

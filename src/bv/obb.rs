@@ -2,8 +2,8 @@
 
 use super::pair::{box_pair_methods, BoxPair, PairSetup, SAT_GUARD};
 use super::{
-    all_finite, face_vertices, l1, listed_vertices, projection_slack, BoundingVolume, BvDefect,
-    BvKind,
+    all_finite, face_vertices, l1, listed_vertices, model_axes_frame, projection_slack,
+    BoundingVolume, BvDefect, BvKind,
 };
 use crate::arr3::{self, dot};
 use crate::pose::Pose;
@@ -116,10 +116,7 @@ impl<R: Real> Obb<R> {
         frame: &Matrix3<f64>,
         points: impl Iterator<Item = &'a [f64; 3]>,
     ) -> Self {
-        // Round the axes first and measure along the rounded ones, so the stored box is
-        // exactly the one whose extents were computed.
-        let axes_r: [[R; 3]; 3] =
-            std::array::from_fn(|i| std::array::from_fn(|j| R::from_f64_nearest(frame[(j, i)])));
+        let axes_r = rounded_rows::<R>(frame);
         let a = axes_r.map(|row| point_to_f64(&row));
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
@@ -135,11 +132,74 @@ impl<R: Real> Obb<R> {
             let m = l1(p);
             l1_max = if m > l1_max { m } else { l1_max };
         }
-        if !lo[0].is_finite() {
-            // No vertices (callers never do this): an empty box at the origin.
-            lo = [0.0; 3];
-            hi = [0.0; 3];
+        Self::from_extremes(axes_r, lo, hi, l1_max)
+    }
+
+    /// [`Obb::enclose_points`] along `frame` and along the model's own axes
+    /// ([`model_axes_frame`] of the points), in one pass: the coordinates' extremes are
+    /// the projections on the model axes, and the largest `|p|₁` is the same for both.
+    // why: as in `enclose_points`.
+    #[allow(clippy::indexing_slicing)]
+    fn enclose_points_fitted_and_aligned<'a>(
+        frame: &Matrix3<f64>,
+        points: impl Iterator<Item = &'a [f64; 3]>,
+    ) -> [(Matrix3<f64>, Self); 2] {
+        let axes_r = rounded_rows::<R>(frame);
+        let a = axes_r.map(|row| point_to_f64(&row));
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut coord_lo = [f64::INFINITY; 3];
+        let mut coord_hi = [f64::NEG_INFINITY; 3];
+        let mut l1_max = 0.0f64;
+        for p in points {
+            for i in 0..3 {
+                let d = dot(a[i], *p);
+                lo[i] = if d < lo[i] { d } else { lo[i] };
+                hi[i] = if d > hi[i] { d } else { hi[i] };
+                let x = p[i];
+                coord_lo[i] = if x < coord_lo[i] { x } else { coord_lo[i] };
+                coord_hi[i] = if x > coord_hi[i] { x } else { coord_hi[i] };
+            }
+            let m = l1(p);
+            l1_max = if m > l1_max { m } else { l1_max };
         }
+        let fitted = Self::from_extremes(axes_r, lo, hi, l1_max);
+        let model = model_axes_frame(coord_lo, coord_hi);
+        // Each model axis is ±1 on one coordinate and 0 on the others (exact in any
+        // precision), so its extremes are those of that coordinate, negated and swapped
+        // for -1: the sums below have one non-zero term.
+        let model_r = rounded_rows::<R>(&model);
+        let m = model_r.map(|row| point_to_f64(&row));
+        let (mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3]);
+        for i in 0..3 {
+            for k in 0..3 {
+                let (l, h) = if m[i][k] < 0.0 {
+                    (coord_hi[k], coord_lo[k])
+                } else {
+                    (coord_lo[k], coord_hi[k])
+                };
+                lo[i] += m[i][k] * l;
+                hi[i] += m[i][k] * h;
+            }
+        }
+        let aligned = Self::from_extremes(model_r, lo, hi, l1_max);
+        [(*frame, fitted), (model, aligned)]
+    }
+
+    /// The box along the (rounded) rows `axes_r` whose points project onto row `i` within
+    /// `[lo[i], hi[i]]` and have `|p|₁ ≤ l1_max`: centred in the middle of those ranges
+    /// (rounded to `R`), with half-widths rounded up and widened by the projections'
+    /// rounding. No points (`lo` infinite): an empty box at the origin.
+    // why: axis numbers in 0..3 on fixed-size arrays.
+    #[allow(clippy::indexing_slicing)]
+    fn from_extremes(axes_r: [[R; 3]; 3], lo: [f64; 3], hi: [f64; 3], l1_max: f64) -> Self {
+        let a = axes_r.map(|row| point_to_f64(&row));
+        let (lo, hi) = if lo[0].is_finite() {
+            (lo, hi)
+        } else {
+            // No vertices (callers never do this).
+            ([0.0; 3], [0.0; 3])
+        };
         let mid: [f64; 3] = std::array::from_fn(|i| 0.5 * (lo[i] + hi[i]));
         let c: [f64; 3] = std::array::from_fn(|j| (0..3).map(|i| a[i][j] * mid[i]).sum());
         let center = c.map(R::from_f64_nearest);
@@ -155,6 +215,13 @@ impl<R: Real> Obb<R> {
             half,
         }
     }
+}
+
+/// The columns of `frame` rounded to `R`, one per row: a box is measured along the
+/// rounded axes, so that the stored box is exactly the one whose extents were computed.
+fn rounded_rows<R: Real>(frame: &Matrix3<f64>) -> [[R; 3]; 3] {
+    let [c0, c1, c2]: [[f64; 3]; 3] = (*frame).into();
+    [c0, c1, c2].map(|column| column.map(R::from_f64_nearest))
 }
 
 /// How many times the guard's share of the slack (`1e-6 · Σh`) the frames' share may reach
@@ -218,15 +285,24 @@ impl<R: Real> BoundingVolume for Obb<R> {
         Self::enclose_points(frame, listed_vertices(positions, vertices))
     }
 
-    fn write_le(&self, out: &mut Vec<u8>) {
-        for v in self
-            .axes
-            .iter()
-            .flatten()
-            .chain(&self.center)
-            .chain(&self.half)
-        {
-            v.write_le(out);
+    fn enclose_vertices_fitted_and_aligned(
+        frame: &Matrix3<f64>,
+        positions: &[[f64; 3]],
+        vertices: &[u32],
+    ) -> [(Matrix3<f64>, Self); 2] {
+        Self::enclose_points_fitted_and_aligned(frame, listed_vertices(positions, vertices))
+    }
+
+    fn write_le(&self, out: &mut [u8]) {
+        let [a0, a1, a2] = self.axes;
+        let (c, h) = (self.center, self.half);
+        // An array rather than chained iterators: the loop then unrolls into plain stores.
+        let scalars = [
+            a0[0], a0[1], a0[2], a1[0], a1[1], a1[2], a2[0], a2[1], a2[2], c[0], c[1], c[2], h[0],
+            h[1], h[2],
+        ];
+        for (o, v) in out.chunks_exact_mut(size_of::<R>()).zip(scalars) {
+            v.write_le(o);
         }
     }
 

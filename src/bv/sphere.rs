@@ -91,9 +91,12 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         Self::enclose_points(frame, listed_vertices(positions, vertices))
     }
 
-    fn write_le(&self, out: &mut Vec<u8>) {
-        for v in self.center.iter().chain([&self.radius]) {
-            v.write_le(out);
+    fn write_le(&self, out: &mut [u8]) {
+        let c = self.center;
+        // An array rather than chained iterators: the loop then unrolls into plain stores.
+        let scalars = [c[0], c[1], c[2], self.radius];
+        for (o, v) in out.chunks_exact_mut(size_of::<R>()).zip(scalars) {
+            v.write_le(o);
         }
     }
 

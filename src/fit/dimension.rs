@@ -56,7 +56,7 @@ pub(crate) fn classify(points: &[V3], magnitude: f64) -> Shape {
     for (i, &p) in points.iter().enumerate() {
         extremes.add(i, p);
     }
-    classify_with(points, magnitude, &extremes)
+    classify_with(points, magnitude, &extremes, false)
 }
 
 /// The bounding box of a point set and, for each side, the first point on it (in order
@@ -114,8 +114,17 @@ fn extend(x: f64, lo: &mut f64, hi: &mut f64, at: &mut [usize; 2], i: usize) {
     }
 }
 
-/// [`classify`], given the [`Extremes`] of `points` (added in order).
-pub(crate) fn classify_with(points: &[V3], magnitude: f64, extremes: &Extremes) -> Shape {
+/// [`classify`], given the [`Extremes`] of `points` (added in order). With
+/// `any_solid_point`, the last pass stops at the first point farther than the tolerance
+/// from the plane: the dimension, line and plane are the same, but `thickness` and
+/// `simplex[3]` are then those of that point rather than the farthest (only the convex
+/// hull, which grows from the simplex, needs the farthest).
+pub(crate) fn classify_with(
+    points: &[V3],
+    magnitude: f64,
+    extremes: &Extremes,
+    any_solid_point: bool,
+) -> Shape {
     let Some(&first) = points.first() else {
         return Shape::point(0.0);
     };
@@ -171,6 +180,9 @@ pub(crate) fn classify_with(points: &[V3], magnitude: f64, extremes: &Extremes) 
         let d = dot(sub(p, p0), normal).abs();
         if d > far3 {
             (i3, far3) = (i, d);
+            if any_solid_point && d > tol {
+                break;
+            }
         }
     }
     shape.normal = normal;

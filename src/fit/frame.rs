@@ -65,17 +65,12 @@ pub(crate) fn in_plane_axis(w: V3) -> V3 {
 /// Makes the sign of `c` deterministic: its largest-magnitude component (the first, on
 /// exact ties) is positive.
 fn fix_sign(c: V3) -> V3 {
+    // Signs and magnitudes of fitted axes are a coin toss: selects, not branches.
     let mut largest = c[0];
     for x in [c[1], c[2]] {
-        if x.abs() > largest.abs() {
-            largest = x;
-        }
+        largest = std::hint::select_unpredictable(x.abs() > largest.abs(), x, largest);
     }
-    if largest < 0.0 {
-        scale(c, -1.0)
-    } else {
-        c
-    }
+    scale(c, std::hint::select_unpredictable(largest < 0.0, -1.0, 1.0))
 }
 
 /// `v` scaled to unit length. Inputs here are almost always unit already (to a few ulps),

@@ -20,8 +20,7 @@
 
 use std::cell::RefCell;
 
-use crate::arr3;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 
 mod covariance;
 mod dimension;
@@ -168,30 +167,6 @@ pub(crate) fn principal_axes_and_vertices(
     } else {
         Matrix3::identity()
     }
-}
-
-/// The model's own axes as a frame for the points `vertices` (indices into `positions`;
-/// out-of-range ones ignored): unit columns, greatest extent first (ties in x, y, z order),
-/// right-handed, the same conventions as a fitted frame.
-pub fn model_axes_frame(positions: &[[f64; 3]], vertices: &[u32]) -> Matrix3<f64> {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in vertices.iter().filter_map(|&v| positions.get(v as usize)) {
-        lo = arr3::min(lo, *p);
-        hi = arr3::max(hi, *p);
-    }
-    let extent = arr3::sub(hi, lo);
-    let mut order = [0usize, 1, 2];
-    // Greatest extent first; a stable sort, so equal extents keep x, y, z order.
-    order.sort_by(|&a, &b| extent[b].total_cmp(&extent[a]));
-    let axis = |k: usize| {
-        let mut v = Vector3::zeros();
-        if let Some(c) = v.get_mut(k) {
-            *c = 1.0;
-        }
-        v
-    };
-    let (c0, c1) = (axis(order[0]), axis(order[1]));
-    Matrix3::from_columns(&[c0, c1, c0.cross(&c1)])
 }
 
 /// Runs `f` on this thread's scratch buffers (fresh ones if those are unavailable).

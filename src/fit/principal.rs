@@ -50,7 +50,10 @@ pub(crate) fn fit(
         }
     }
     s.gather(positions, faces, method == FitMethod::Vertices);
-    let shape = classify_with(&s.pts, s.magnitude, &s.extremes);
+    // Only the hull (unsampled) grows from the farthest points; the other fits need the
+    // dimension, line and plane alone.
+    let hull_needs_simplex = method == FitMethod::Hull && s.pts.len() <= hull_points;
+    let shape = classify_with(&s.pts, s.magnitude, &s.extremes, !hull_needs_simplex);
     match shape.dim {
         0 => return Matrix3::identity(),
         1 => {

@@ -281,12 +281,9 @@ fn write_nodes<B: BoundingVolume>(
     let hashers: Vec<Result<crc32fast::Hasher, WriteError>> = runs
         .into_par_iter()
         .map(|(drafts, shift, out)| {
-            let mut record = Vec::with_capacity(size);
             for (out, d) in out.chunks_exact_mut(size).zip(drafts) {
                 let packed = encoding.encode(d.shifted(shift).refs)?;
-                record.clear();
-                Node::new(d.bv, packed).write_le(&mut record);
-                out.copy_from_slice(&record);
+                Node::new(d.bv, packed).write_le(out);
             }
             let mut h = crc32fast::Hasher::new();
             h.update(out);
