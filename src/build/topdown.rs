@@ -6,8 +6,9 @@
 //! build gives, so the output never depends on scheduling.
 
 use super::BuildOptions;
+use crate::arr3::dot;
 use crate::bv::BoundingVolume;
-use crate::fit::{principal_axes, principal_axes_and_vertices, FitMethod};
+use crate::fit::{principal_axes, principal_axes_and_vertices, FaceMoment, FaceMoments, FitMethod};
 use crate::format::NodeRun;
 use crate::stats::TreeShape;
 use crate::tree::{Draft, NodeRef};
@@ -158,6 +159,9 @@ struct Context<'a> {
     /// Single-face leaves get their volumes later, from `leaf_volume` (a placeholder until
     /// then).
     defer_leaves: bool,
+    /// The area moments of every input face, by input id, when some node is fitted to its
+    /// triangles (empty otherwise).
+    face_moments: &'a [FaceMoment],
 }
 
 pub(crate) fn build_drafts<B: BoundingVolume>(
@@ -173,11 +177,22 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
     // apart, alongside the tree: that work keeps the second core busy while the first
     // is still fitting the root, which nothing else can start before.
     let defer_leaves = options.leaf_size == 1;
+    // Nodes of one face take their frame from the triangle itself; larger ones may be
+    // fitted to their triangles' moments, which are then worth computing once.
+    let face_moments: Vec<FaceMoment> = if options.fit_for(2) == FitMethod::Triangles {
+        input_faces
+            .par_iter()
+            .map(|f| FaceMoment::of(positions, f).unwrap_or_default())
+            .collect()
+    } else {
+        Vec::new()
+    };
     let ctx = Context {
         positions,
         options,
         progress,
         defer_leaves,
+        face_moments: &face_moments,
     };
     let (tree, leaf_volumes) = if defer_leaves {
         let (tree, volumes) = rayon::join(
@@ -242,11 +257,20 @@ fn fit_and_split<B: BoundingVolume>(
     }
     let fit = ctx.options.fit_for(faces.len());
     let hull_points = ctx.options.hull_max_points as usize;
+    let moments = if ctx.face_moments.is_empty() {
+        FaceMoments::FromCorners
+    } else {
+        FaceMoments::Table {
+            table: ctx.face_moments,
+            ids,
+        }
+    };
     let axes = principal_axes_and_vertices(
         fit,
         hull_points,
         ctx.positions,
         faces,
+        moments,
         &mut scratch.vertices,
     );
     let (axes, bv) = if ctx.options.model_axes {
@@ -272,32 +296,34 @@ fn fit_and_split<B: BoundingVolume>(
     }
     // The first column: the axis of greatest spread.
     let [axis, _, _]: [[f64; 3]; 3] = axes.into();
-    (
-        bv,
-        Some(split(ctx.positions, axis, faces, ids, &mut scratch.proj)),
-    )
+    let proj = &mut scratch.proj;
+    proj.clear();
+    if ctx.face_moments.is_empty() {
+        proj.extend(faces.iter().map(|f| {
+            // Sum of the corners: the centroid times 3, which orders the same way.
+            let mut s = 0.0;
+            for &v in f {
+                if let Some(p) = ctx.positions.get(v as usize) {
+                    s += dot(axis, *p);
+                }
+            }
+            s
+        }));
+    } else {
+        // The centroids are at hand in the moments table.
+        let centroid = |i: u32| ctx.face_moments.get(i as usize).map(FaceMoment::centroid);
+        proj.extend(
+            ids.iter()
+                .map(|&i| centroid(i).map_or(0.0, |c| dot(axis, c))),
+        );
+    }
+    (bv, Some(split(faces, ids, proj)))
 }
 
-/// Partitions by centroid projection on `axis`: below the mean to the front. If that leaves
-/// one side empty (all centroids project alike), splits at the median of the projections.
-fn split(
-    positions: &[[f64; 3]],
-    axis: [f64; 3],
-    faces: &mut [[u32; 3]],
-    ids: &mut [u32],
-    proj: &mut Vec<f64>,
-) -> usize {
-    proj.clear();
-    proj.extend(faces.iter().map(|f| {
-        // Sum of the corners: the centroid times 3, which orders the same way.
-        let mut s = 0.0;
-        for &v in f {
-            if let Some(p) = positions.get(v as usize) {
-                s += axis[0] * p[0] + axis[1] * p[1] + axis[2] * p[2];
-            }
-        }
-        s
-    }));
+/// Partitions by the centroid projections `proj` (one per face): below the mean to the
+/// front. If that leaves one side empty (all centroids project alike), splits at the median
+/// of the projections.
+fn split(faces: &mut [[u32; 3]], ids: &mut [u32], proj: &mut [f64]) -> usize {
     let mean = proj.iter().sum::<f64>() / proj.len() as f64;
     let (mut i, mut j) = (0, proj.len());
     while i < j {

@@ -10,7 +10,7 @@
 //! covariance is translation invariant); that keeps the final `E[x xᵀ] − m mᵀ`
 //! subtraction free of catastrophic cancellation for data far from the origin.
 
-use crate::arr3::{cross, norm2, V3};
+use crate::arr3::{cross, norm2, scale, sub, V3};
 
 /// A symmetric 3×3 matrix stored as `[xx, yy, zz, xy, xz, yz]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -65,6 +65,52 @@ enum Kind {
     Points,
 }
 
+/// One triangle's area moments about its own centroid: the part of a face's contribution
+/// to [`Moments`] that does not depend on the reference origin. A build computes it once
+/// per face and sums it at every level of the tree (the parallel-axis theorem moves it to
+/// each node's origin), where recomputing it from the corners took a sixth of a build.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct FaceMoment {
+    /// Twice the area.
+    weight: f64,
+    /// The mean of the three corners.
+    centroid: V3,
+    /// `weight · Σ (v − centroid)(v − centroid)ᵀ` over the corners, laid out as [`Sym3`].
+    central: [f64; 6],
+}
+
+impl FaceMoment {
+    /// The moments of triangle `(p, q, r)`.
+    #[inline]
+    pub(crate) fn new(p: V3, q: V3, r: V3) -> FaceMoment {
+        let weight = norm2(cross(sub(q, p), sub(r, p))).sqrt();
+        let centroid = scale(
+            [p[0] + q[0] + r[0], p[1] + q[1] + r[1], p[2] + q[2] + r[2]],
+            1.0 / 3.0,
+        );
+        let [a, b, c] = [sub(p, centroid), sub(q, centroid), sub(r, centroid)];
+        let e = |j: usize, k: usize| weight * (a[j] * a[k] + b[j] * b[k] + c[j] * c[k]);
+        FaceMoment {
+            weight,
+            centroid,
+            central: [e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(0, 2), e(1, 2)],
+        }
+    }
+
+    /// The moments of `face`, or `None` if an index is out of range.
+    #[inline]
+    pub(crate) fn of(positions: &[[f64; 3]], face: &[u32; 3]) -> Option<FaceMoment> {
+        let [a, b, c] = face.map(|v| positions.get(v as usize));
+        Some(FaceMoment::new(*a?, *b?, *c?))
+    }
+
+    /// The mean of the corners.
+    #[inline]
+    pub(crate) fn centroid(&self) -> V3 {
+        self.centroid
+    }
+}
+
 /// Running sums of weight, first moment and second moment about the reference origin.
 /// One accumulator holds either triangles or points, not both.
 #[derive(Clone, Copy, Debug, Default)]
@@ -106,6 +152,29 @@ impl Moments {
         self.second[3] += w * e(x, y);
         self.second[4] += w * e(x, z);
         self.second[5] += w * e(y, z);
+        self.kind = Kind::Area;
+    }
+
+    /// Adds the uniform area distribution of a face from its [`FaceMoment`], in
+    /// coordinates relative to `origin`: with `d` its centroid less the origin, the
+    /// corners' `Σ v vᵀ` is the central sum plus `3 d dᵀ`, and the triangle's second-moment
+    /// term (see [`Moments::add_triangle`]) `9 d dᵀ + Σ v vᵀ` is the central sum plus
+    /// `12 d dᵀ`.
+    #[inline]
+    pub(crate) fn add_face(&mut self, f: &FaceMoment, origin: V3) {
+        let d = sub(f.centroid, origin);
+        let wd = scale(d, f.weight);
+        let c = &f.central;
+        self.weight += f.weight;
+        self.first[0] += 3.0 * wd[0];
+        self.first[1] += 3.0 * wd[1];
+        self.first[2] += 3.0 * wd[2];
+        self.second[0] += c[0] + 12.0 * wd[0] * d[0];
+        self.second[1] += c[1] + 12.0 * wd[1] * d[1];
+        self.second[2] += c[2] + 12.0 * wd[2] * d[2];
+        self.second[3] += c[3] + 12.0 * wd[0] * d[1];
+        self.second[4] += c[4] + 12.0 * wd[0] * d[2];
+        self.second[5] += c[5] + 12.0 * wd[1] * d[2];
         self.kind = Kind::Area;
     }
 

@@ -34,6 +34,22 @@ mod scratch;
 mod symmetry;
 mod triangle;
 
+pub(crate) use covariance::FaceMoment;
+
+/// Where a fit finds the area moments of its faces (for [`FitMethod::Triangles`], and the
+/// hull's fallback).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum FaceMoments<'a> {
+    /// Computed from the corners, face by face.
+    FromCorners,
+    /// `table[ids[k]]` is the moment of `faces[k]`: a build's table of every face (see
+    /// [`FaceMoment`]), made once and summed at every level.
+    Table {
+        table: &'a [FaceMoment],
+        ids: &'a [u32],
+    },
+}
+
 /// Which covariance the OBB frame is computed from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum FitMethod {
@@ -129,7 +145,10 @@ pub fn principal_axes(
             (Some(&p), Some(&q), Some(&r)) => triangle::triangle_frame(p, q, r),
             _ => Matrix3::identity(),
         },
-        _ => with_scratch(|s| principal::fit(s, method, usize::MAX, positions, faces)),
+        _ => with_scratch(|s| {
+            let from_corners = FaceMoments::FromCorners;
+            principal::fit(s, method, usize::MAX, positions, faces, from_corners)
+        }),
     };
     if frame.iter().all(|v| v.is_finite()) {
         frame
@@ -142,12 +161,15 @@ pub fn principal_axes(
 /// (in range, each once, in some deterministic order), which the fit finds anyway. With
 /// [`FitMethod::Hull`], a face set of more than `hull_points` distinct vertices has its
 /// hull taken over an evenly spaced sample of `hull_points` of them and the six that reach
-/// its bounding box (`usize::MAX`: every vertex, as [`principal_axes`] does).
+/// its bounding box (`usize::MAX`: every vertex, as [`principal_axes`] does). `moments`
+/// says where the faces' area moments come from; a table gives the same frame as
+/// computing them, faster.
 pub(crate) fn principal_axes_and_vertices(
     method: FitMethod,
     hull_points: usize,
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
+    moments: FaceMoments<'_>,
     vertices: &mut Vec<u32>,
 ) -> Matrix3<f64> {
     vertices.clear();
@@ -158,7 +180,7 @@ pub(crate) fn principal_axes_and_vertices(
         return principal_axes(method, positions, faces);
     }
     let frame = with_scratch(|s| {
-        let frame = principal::fit(s, method, hull_points, positions, faces);
+        let frame = principal::fit(s, method, hull_points, positions, faces, moments);
         vertices.extend_from_slice(&s.ids);
         frame
     });

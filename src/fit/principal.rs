@@ -8,15 +8,15 @@
 
 use nalgebra::Matrix3;
 
-use super::covariance::{Moments, Sym3};
+use super::covariance::{FaceMoment, Moments, Sym3};
 use super::dimension::{classify, classify_with, Shape};
 use super::eigen::{axes2, axes3};
 use super::frame::{finish, Frame};
 use super::hull::{is_flat, plane_basis};
 use super::scratch::Scratch;
 use super::symmetry::{refine, LargestTriangles};
-use super::FitMethod;
-use crate::arr3::{sub, V3};
+use super::{FaceMoments, FitMethod};
+use crate::arr3::V3;
 
 /// Where the covariance came from; the same triangles propose axes for tied eigenvalues.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,13 +38,14 @@ pub(crate) fn fit(
     hull_points: usize,
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
+    moments: FaceMoments<'_>,
 ) -> Matrix3<f64> {
     let mut method = method;
     // The triangle covariance decides, by its area, whether the method applies at all,
     // and the vertex method needs welded points: settle the method before gathering.
     let mut tri_cov = None;
     if method == FitMethod::Triangles {
-        tri_cov = triangle_covariance(positions, faces);
+        tri_cov = triangle_covariance(positions, faces, moments);
         if tri_cov.is_none() {
             method = FitMethod::Vertices;
         }
@@ -75,7 +76,7 @@ pub(crate) fn fit(
         };
         result = hull_frame(s, &shape);
         if result.is_none() {
-            tri_cov = triangle_covariance(positions, faces);
+            tri_cov = triangle_covariance(positions, faces, moments);
         }
     }
     if result.is_none() {
@@ -159,21 +160,29 @@ fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Frame, Source)> {
 }
 
 /// Area covariance of the given faces, or `None` when their total area is zero.
-fn triangle_covariance(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Option<Sym3> {
-    // Coordinates relative to one of the vertices keep the moment sums small.
-    let origin = faces
-        .iter()
-        .find_map(|f| positions.get(f[0] as usize))
-        .copied()?;
+fn triangle_covariance(
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    moments: FaceMoments<'_>,
+) -> Option<Sym3> {
+    match moments {
+        FaceMoments::FromCorners => {
+            area_covariance(faces.iter().filter_map(|f| FaceMoment::of(positions, f)))
+        }
+        FaceMoments::Table { table, ids } => {
+            area_covariance(ids.iter().filter_map(|&i| table.get(i as usize)).copied())
+        }
+    }
+}
+
+/// The area covariance of faces given by their moments, or `None` when they have no
+/// area. Sums are taken relative to the first face's centroid, which keeps them small.
+fn area_covariance(faces: impl Iterator<Item = FaceMoment>) -> Option<Sym3> {
+    let mut faces = faces.peekable();
+    let origin = faces.peek()?.centroid();
     let mut m = Moments::default();
     for f in faces {
-        if let (Some(&p), Some(&q), Some(&r)) = (
-            positions.get(f[0] as usize),
-            positions.get(f[1] as usize),
-            positions.get(f[2] as usize),
-        ) {
-            m.add_triangle(sub(p, origin), sub(q, origin), sub(r, origin));
-        }
+        m.add_face(&f, origin);
     }
     if m.weight() > 0.0 {
         m.covariance()
