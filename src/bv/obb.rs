@@ -109,80 +109,45 @@ impl<R: Real> Obb<R> {
     }
 
     /// The box of `points` along `frame`'s columns (see [`BoundingVolume::enclose`]).
-    // why: axis numbers in 0..3 on fixed-size arrays. The hottest loop of a build, kept as
-    // written: index-free forms cost 0.2-0.5% of a whole OBB build (callgrind).
-    #[allow(clippy::indexing_slicing)]
     fn enclose_points<'a>(
         frame: &Matrix3<f64>,
         points: impl Iterator<Item = &'a [f64; 3]>,
     ) -> Self {
         let axes_r = rounded_rows::<R>(frame);
-        let a = axes_r.map(|row| point_to_f64(&row));
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let mut l1_max = 0.0f64;
-        for p in points {
-            // Plain comparisons (not `f64::min`, which must also handle NaN): one
-            // instruction each on the hottest loop of a build.
-            for i in 0..3 {
-                let d = dot(a[i], *p);
-                lo[i] = if d < lo[i] { d } else { lo[i] };
-                hi[i] = if d > hi[i] { d } else { hi[i] };
-            }
-            let m = l1(p);
-            l1_max = if m > l1_max { m } else { l1_max };
-        }
-        Self::from_extremes(axes_r, lo, hi, l1_max)
+        let scan = Scan::of::<false>(&axes_r.map(|row| point_to_f64(&row)), points);
+        Self::from_extremes(axes_r, scan.lo, scan.hi, scan.l1_max)
     }
 
     /// [`Obb::enclose_points`] along `frame` and along the model's own axes
     /// ([`model_axes_frame`] of the points), in one pass: the coordinates' extremes are
     /// the projections on the model axes, and the largest `|p|₁` is the same for both.
-    // why: as in `enclose_points`.
-    #[allow(clippy::indexing_slicing)]
     fn enclose_points_fitted_and_aligned<'a>(
         frame: &Matrix3<f64>,
         points: impl Iterator<Item = &'a [f64; 3]>,
     ) -> [(Matrix3<f64>, Self); 2] {
         let axes_r = rounded_rows::<R>(frame);
-        let a = axes_r.map(|row| point_to_f64(&row));
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let mut coord_lo = [f64::INFINITY; 3];
-        let mut coord_hi = [f64::NEG_INFINITY; 3];
-        let mut l1_max = 0.0f64;
-        for p in points {
-            for i in 0..3 {
-                let d = dot(a[i], *p);
-                lo[i] = if d < lo[i] { d } else { lo[i] };
-                hi[i] = if d > hi[i] { d } else { hi[i] };
-                let x = p[i];
-                coord_lo[i] = if x < coord_lo[i] { x } else { coord_lo[i] };
-                coord_hi[i] = if x > coord_hi[i] { x } else { coord_hi[i] };
-            }
-            let m = l1(p);
-            l1_max = if m > l1_max { m } else { l1_max };
-        }
-        let fitted = Self::from_extremes(axes_r, lo, hi, l1_max);
-        let model = model_axes_frame(coord_lo, coord_hi);
+        let scan = Scan::of::<true>(&axes_r.map(|row| point_to_f64(&row)), points);
+        let fitted = Self::from_extremes(axes_r, scan.lo, scan.hi, scan.l1_max);
+        let model = model_axes_frame(scan.coord_lo, scan.coord_hi);
         // Each model axis is ±1 on one coordinate and 0 on the others (exact in any
         // precision), so its extremes are those of that coordinate, negated and swapped
         // for -1: the sums below have one non-zero term.
         let model_r = rounded_rows::<R>(&model);
         let m = model_r.map(|row| point_to_f64(&row));
         let (mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3]);
-        for i in 0..3 {
-            for k in 0..3 {
-                let (l, h) = if m[i][k] < 0.0 {
-                    (coord_hi[k], coord_lo[k])
+        for (row, (lo, hi)) in m.iter().zip(lo.iter_mut().zip(hi.iter_mut())) {
+            let coords = scan.coord_lo.iter().zip(&scan.coord_hi);
+            for (&x, (&coord_lo, &coord_hi)) in row.iter().zip(coords) {
+                let (l, h) = if x < 0.0 {
+                    (coord_hi, coord_lo)
                 } else {
-                    (coord_lo[k], coord_hi[k])
+                    (coord_lo, coord_hi)
                 };
-                lo[i] += m[i][k] * l;
-                hi[i] += m[i][k] * h;
+                *lo += x * l;
+                *hi += x * h;
             }
         }
-        let aligned = Self::from_extremes(model_r, lo, hi, l1_max);
+        let aligned = Self::from_extremes(model_r, lo, hi, scan.l1_max);
         [(*frame, fitted), (model, aligned)]
     }
 
@@ -214,6 +179,60 @@ impl<R: Real> Obb<R> {
             center,
             half,
         }
+    }
+}
+
+/// One pass over a box's points: the extremes of their projections on three rows, of their
+/// coordinates (when asked: the projections on the model's axes), and of `|p|₁`.
+struct Scan {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    coord_lo: [f64; 3],
+    coord_hi: [f64; 3],
+    l1_max: f64,
+}
+
+impl Scan {
+    // why: axis numbers in 0..3 on fixed-size arrays. The hottest loop of a build, kept as
+    // written: index-free forms cost 0.2-0.5% of a whole OBB build (callgrind).
+    #[allow(clippy::indexing_slicing)]
+    #[inline(always)]
+    fn of<'a, const COORDS: bool>(
+        rows: &[[f64; 3]; 3],
+        points: impl Iterator<Item = &'a [f64; 3]>,
+    ) -> Scan {
+        let mut scan = Scan {
+            lo: [f64::INFINITY; 3],
+            hi: [f64::NEG_INFINITY; 3],
+            coord_lo: [f64::INFINITY; 3],
+            coord_hi: [f64::NEG_INFINITY; 3],
+            l1_max: 0.0,
+        };
+        for p in points {
+            // Plain comparisons (not `f64::min`, which must also handle NaN): one
+            // instruction each.
+            for i in 0..3 {
+                let d = dot(rows[i], *p);
+                scan.lo[i] = if d < scan.lo[i] { d } else { scan.lo[i] };
+                scan.hi[i] = if d > scan.hi[i] { d } else { scan.hi[i] };
+                if COORDS {
+                    let x = p[i];
+                    scan.coord_lo[i] = if x < scan.coord_lo[i] {
+                        x
+                    } else {
+                        scan.coord_lo[i]
+                    };
+                    scan.coord_hi[i] = if x > scan.coord_hi[i] {
+                        x
+                    } else {
+                        scan.coord_hi[i]
+                    };
+                }
+            }
+            let m = l1(p);
+            scan.l1_max = if m > scan.l1_max { m } else { scan.l1_max };
+        }
+        scan
     }
 }
 
