@@ -370,3 +370,51 @@ fn model_axes_replace_a_fitted_box_only_where_theirs_is_smaller() {
         "{aligned} nodes on the model's axes with the candidate, {aligned_without} without"
     );
 }
+
+/// The builder measures a node along its fitted frame and along the model's axes in one
+/// scan; each box must be exactly the one the two separate enclosures give, the second
+/// along `model_axes_frame` of the vertices' bounds. The cow's vertices, split into node-
+/// like runs, along the identity, a turned frame and the cow's own principal axes, for every
+/// volume type and precision.
+#[test]
+fn one_scan_encloses_along_the_fit_and_the_model_axes_as_two_enclosures_do() {
+    use obbtree::bv::model_axes_frame;
+    use obbtree::fit::principal_axes;
+    fn check<B: BoundingVolume + PartialEq>(
+        positions: &[[f64; 3]],
+        frames: &[nalgebra::Matrix3<f64>],
+    ) {
+        let all: Vec<u32> = (0..positions.len() as u32).collect();
+        for run in all.chunks(97).chain([all.as_slice(), &all[..3], &all[..1]]) {
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for &v in run {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(positions[v as usize][k]);
+                    hi[k] = hi[k].max(positions[v as usize][k]);
+                }
+            }
+            let model = model_axes_frame(lo, hi);
+            for frame in frames {
+                let [(f_axes, fitted), (m_axes, aligned)] =
+                    B::enclose_vertices_fitted_and_aligned(frame, positions, run);
+                assert_eq!(f_axes, *frame);
+                assert_eq!(m_axes, model);
+                assert_eq!(fitted, B::enclose_vertices(frame, positions, run));
+                assert_eq!(aligned, B::enclose_vertices(&model, positions, run));
+            }
+        }
+    }
+    let cow = common::cow();
+    let positions = cow.vertices();
+    let frames = [
+        nalgebra::Matrix3::identity(),
+        common::rng::seeded_rotation(5),
+        principal_axes(FitMethod::Hull, positions, cow.faces()),
+    ];
+    check::<Obb<f32>>(positions, &frames);
+    check::<Obb<f64>>(positions, &frames);
+    check::<Aabb<f32>>(positions, &frames);
+    check::<Aabb<f64>>(positions, &frames);
+    check::<Sphere<f32>>(positions, &frames);
+    check::<Sphere<f64>>(positions, &frames);
+}

@@ -225,3 +225,52 @@ impl Moments {
         c.is_finite().then_some(c)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A face's moments moved to an origin by the parallel-axis theorem give the same
+    /// covariance as the triangle summed from its corners relative to that origin: for
+    /// triangles of every shape (slivers included) and size, near and far from the origin.
+    #[test]
+    fn face_moments_moved_to_an_origin_match_the_triangles_summed_there() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for case in 0..2000 {
+            let scale = [1e-3, 1.0, 1e3][case % 3];
+            let far = [0.0, 1.0, 1e4][case / 3 % 3];
+            let mut corner = || [0, 1, 2].map(|_| far + scale * next());
+            let mut faces = [[[0.0; 3]; 3]; 4];
+            for f in &mut faces {
+                *f = [corner(), corner(), corner()];
+            }
+            if case % 7 == 0 {
+                // A sliver: the third corner on the first edge, nearly.
+                let [p, q, _] = faces[0];
+                faces[0][2] = [0, 1, 2].map(|k| 0.5 * (p[k] + q[k]) + 1e-9 * scale);
+            }
+            let origin = faces[0][0];
+            let (mut corners, mut moved) = (Moments::default(), Moments::default());
+            for [p, q, r] in faces {
+                corners.add_triangle(sub(p, origin), sub(q, origin), sub(r, origin));
+                moved.add_face(&FaceMoment::new(p, q, r), origin);
+            }
+            let (a, b) = (corners.covariance().unwrap(), moved.covariance().unwrap());
+            let size = a.max_abs();
+            // Relative to the squared coordinates' size: the rounding of either sum.
+            let tolerance = 1e-12 * (size + (far * far + scale * scale) * 1e-4);
+            for (x, y) in a.0.iter().zip(b.0) {
+                assert!(
+                    (x - y).abs() <= tolerance,
+                    "case {case}: {a:?} against {b:?}"
+                );
+            }
+        }
+    }
+}
