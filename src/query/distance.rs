@@ -101,17 +101,6 @@ struct Distance {
     best: Best,
 }
 
-/// The share of the error allowances a dive of the traversal takes ([`Policy::dive_into`]);
-/// the pairs taken off the heap get all of them. With all of them a dive stops as soon as
-/// its child is within the allowance of the best answer so far, and may never reach the
-/// closer pair that lets everything waiting be pruned; with none it chases improvements
-/// the answer does not need. Node pairs with `rel_err` 0.01, summed over 8 poses
-/// (bunny, bunny–fandisk, sliding spheres) and over the 30 cow poses of
-/// `tests/distance_work.rs`: share 0.5: 9,886 and 25,725; 0.7: 8,964 and 24,783; 0.75:
-/// 8,732 and 24,897; from 0.8 on, one bunny pose takes 5 times the pairs (3,493 against
-/// 683), and at 1.0 2,000 pairs where 0.7 takes 671.
-const DIVE_SHARE: f64 = 0.7;
-
 impl Distance {
     /// Measures one triangle pair and keeps it if it is the best so far.
     fn measure(&mut self, fa: u32, a: &Triangle, fb: u32, b: &Triangle, stats: &mut Stats) -> Flow {
@@ -187,6 +176,7 @@ impl Distance {
 
 impl<B: BoundingVolume> Policy<B> for Distance {
     const ORDERED: bool = true;
+    const DIVE_BY_CENTRES: bool = true;
 
     #[inline]
     fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64 {
@@ -196,11 +186,6 @@ impl<B: BoundingVolume> Policy<B> for Distance {
     #[inline]
     fn keep(&self, key: f64) -> bool {
         self.may_improve(key, self.rel_err, self.abs_err)
-    }
-
-    #[inline]
-    fn dive_into(&self, key: f64) -> bool {
-        self.may_improve(key, DIVE_SHARE * self.rel_err, DIVE_SHARE * self.abs_err)
     }
 
     #[inline]

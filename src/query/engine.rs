@@ -45,16 +45,13 @@ pub(crate) trait Policy<B: BoundingVolume> {
     fn nearest_first(&self) -> bool {
         false
     }
-    /// Whether a dive of an ordered traversal continues into a child with this key: by
-    /// default when it is kept. Must hold wherever `keep` does, with the same monotony (a
-    /// child refused here is dropped for good, when it is keyed). A distance query with an
-    /// error allowance dives with part of it and applies all of it to the pairs it takes
-    /// off the heap: so it looks for a better answer wherever a dive is cheap, and stops
-    /// once the allowance covers everything waiting.
-    #[inline]
-    fn dive_into(&self, key: f64) -> bool {
-        self.keep(key)
-    }
+    /// Whether a dive of an ordered traversal chooses between two children by the mean of
+    /// their key and the distance between the volumes' centres, rather than by the key
+    /// alone. A distance bound favours the larger box, which reaches further; the centres
+    /// say where the surfaces are. The dive lands nearer the closest pair, and its answer
+    /// prunes more of what waits (README, Benchmarks: `rel_err` 0.01 29% fewer node
+    /// pairs over 53 poses).
+    const DIVE_BY_CENTRES: bool = false;
     /// Tests one triangle pair (A's triangle in A's frame, B's mapped into it).
     /// `face_a` / `face_b` are leaf-ordered face indices.
     fn triangles(
@@ -239,7 +236,8 @@ fn triangle<B: BoundingVolume>(
 /// Unordered policies (collision) go depth first and test a pair when it is taken, as
 /// RAPID's recursion does: a first-contact query that stops never tests the pairs still
 /// waiting. Ordered policies (distance, span) key a pair when it is pushed and dive: each
-/// expansion continues with its smallest-keyed child down to a triangle pair (a first
+/// expansion continues with its most promising child (smallest key, or see
+/// [`Policy::DIVE_BY_CENTRES`]) down to a triangle pair (a first
 /// answer to prune with, one step per level), the other children wait on a heap, and the
 /// next dive starts from the smallest key waiting, wherever in the trees it is (up to the
 /// [`Frontier`]'s heap size). The traversal ends as soon as that smallest key is pruned,
@@ -310,7 +308,6 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
     // The child a dive continues with, taken before anything waiting.
     let mut dive: Option<Pending> = None;
     loop {
-        let from_dive = dive.is_some();
         let taken = match dive.take() {
             Some(pair) => Some((pair, false)),
             None => waiting.take(),
@@ -333,12 +330,7 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
         } else {
             policy.key(&na.bv, &nb.bv, b_to_a)
         };
-        let kept = if from_dive {
-            policy.dive_into(key)
-        } else {
-            policy.keep(key)
-        };
-        if !kept {
+        if !policy.keep(key) {
             stats.bv_disjoint += 1;
             if P::ORDERED && smallest {
                 // The smallest key waiting is pruned, so is every other: they were all
@@ -425,6 +417,33 @@ impl<B: BoundingVolume> Step<'_, '_, B> {
             .node(c)
             .ok_or(corrupt(self.side, NodeDefect::Missing))
     }
+
+    /// The centre of the other node's volume, in A's frame (where B's are mapped).
+    #[inline(always)]
+    fn other_centre(&self, b_to_a: &Pose) -> Vector3<f64> {
+        centre_in_a(self.other_bv, self.side == Side::A, b_to_a)
+    }
+
+    /// The centre of child `c`'s volume, in A's frame.
+    #[inline(always)]
+    fn child_centre(&self, c: u32, b_to_a: &Pose) -> Result<Vector3<f64>, QueryError> {
+        Ok(centre_in_a(
+            &self.child(c)?.bv,
+            self.side == Side::B,
+            b_to_a,
+        ))
+    }
+}
+
+/// The centre of `bv` in A's frame: mapped by `b_to_a` if it is one of B's volumes.
+#[inline(always)]
+fn centre_in_a<B: BoundingVolume>(bv: &B, of_b: bool, b_to_a: &Pose) -> Vector3<f64> {
+    let c = Vector3::from(bv.center());
+    if of_b {
+        b_to_a.apply(&c)
+    } else {
+        c
+    }
 }
 
 /// Puts the pairs of a step's two children (a binary tree's) on the stack nearer last, so
@@ -436,22 +455,11 @@ fn push_nearest_last<B: BoundingVolume>(
     b_to_a: &Pose,
     waiting: &mut impl Waiting,
 ) -> Result<(), QueryError> {
-    let side = step.side;
     let pair = |c: u32| step.pair(c, 0.0);
     let (first, second) = (step.children.start, step.children.start.wrapping_add(1));
-    // Centres in A's frame, where B's are mapped.
-    let in_a = |bv: &B, of_b: bool| {
-        let c = Vector3::from(bv.center());
-        if of_b {
-            b_to_a.apply(&c)
-        } else {
-            c
-        }
-    };
-    let other_centre = in_a(step.other_bv, side == Side::A);
+    let other_centre = step.other_centre(b_to_a);
     let distance = |c: u32| -> Result<f64, QueryError> {
-        let child = step.child(c)?;
-        Ok((in_a(&child.bv, side == Side::B) - other_centre).norm_squared())
+        Ok((step.child_centre(c, b_to_a)? - other_centre).norm_squared())
     };
     // (A NaN distance, from a damaged file, compares false: the first child first.)
     if distance(second)? < distance(first)? {
@@ -464,41 +472,17 @@ fn push_nearest_last<B: BoundingVolume>(
     Ok(())
 }
 
-/// For an ordered policy, the smaller-keyed of `dive` and `pair`, the other put waiting
-/// (the traversal continues with the closest child at once: a greedy dive that reaches a
-/// triangle pair, and a first answer to prune with, in one step per level). Unordered
-/// policies put every pair waiting.
-#[inline(always)]
-fn keep_smaller<P: Policy<B>, B: BoundingVolume>(
-    dive: Option<Pending>,
-    pair: Pending,
-    waiting: &mut impl Waiting,
-) -> Option<Pending> {
-    if !P::ORDERED {
-        waiting.put(pair);
-        return None;
-    }
-    match dive {
-        Some(d) if d.key() <= pair.key() => {
-            waiting.put(pair);
-            Some(d)
-        }
-        Some(d) => {
-            waiting.put(d);
-            Some(pair)
-        }
-        None => Some(pair),
-    }
-}
-
 /// Puts the pairs of a step's children with the other tree's node waiting, keyed now if
-/// the policy is ordered; returns the child pair a dive continues with (see
-/// [`keep_smaller`]).
+/// the policy is ordered; returns the child pair a dive continues with.
 ///
-/// An ordered policy's pair whose key even a dive refuses is counted as a pruned pair and
-/// dropped rather than put waiting: the best answer only improves, so it would be refused
-/// when taken too, and a heap push and pop cost more than its key (bunny–fandisk, exact
-/// distance: a fifth of the pairs, with `rel_err` 0.01 half).
+/// An ordered traversal continues with one child at once, the rest wait: a greedy dive
+/// that reaches a triangle pair, and a first answer to prune with, in one step per level.
+/// It takes the child of smaller key, or with [`Policy::DIVE_BY_CENTRES`] of smaller mean
+/// of key and centre distance. An ordered policy's pair whose key is refused is counted as
+/// a pruned pair and dropped rather than put waiting: the best answer only
+/// improves, so it would be refused when taken too, and a heap push and pop cost more
+/// than its key (bunny–fandisk, exact distance: a fifth of the pairs, with `rel_err` 0.01
+/// half).
 #[inline(always)]
 fn push_children<B: BoundingVolume, P: Policy<B>>(
     step: &Step<'_, '_, B>,
@@ -512,24 +496,42 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
         push_nearest_last(step, b_to_a, waiting)?;
         return Ok(None);
     }
-    let mut dive = None;
-    for c in step.children.clone() {
-        let key = if P::ORDERED {
-            let child = step.child(c)?;
-            let key = ordered_key(match step.side {
-                Side::A => policy.key(&child.bv, step.other_bv, b_to_a),
-                Side::B => policy.key(step.other_bv, &child.bv, b_to_a),
-            });
-            if !policy.dive_into(key) {
-                stats.nodes_visited += 1;
-                stats.bv_disjoint += 1;
-                continue;
-            }
-            key
-        } else {
-            0.0
-        };
-        dive = keep_smaller::<P, B>(dive, step.pair(c, key), waiting);
+    if !P::ORDERED {
+        for c in step.children.clone() {
+            waiting.put(step.pair(c, 0.0));
+        }
+        return Ok(None);
     }
-    Ok(dive)
+    // The pair a dive continues with, and what it was chosen by.
+    let mut dive: Option<(Pending, f64)> = None;
+    let other_centre = P::DIVE_BY_CENTRES.then(|| step.other_centre(b_to_a));
+    for c in step.children.clone() {
+        let child = step.child(c)?;
+        let key = ordered_key(match step.side {
+            Side::A => policy.key(&child.bv, step.other_bv, b_to_a),
+            Side::B => policy.key(step.other_bv, &child.bv, b_to_a),
+        });
+        if !policy.keep(key) {
+            stats.nodes_visited += 1;
+            stats.bv_disjoint += 1;
+            continue;
+        }
+        let pair = step.pair(c, key);
+        let rank = match other_centre {
+            Some(other) => 0.5 * (key + (step.child_centre(c, b_to_a)? - other).norm()),
+            None => key,
+        };
+        dive = match dive {
+            Some((d, d_rank)) if d_rank <= rank => {
+                waiting.put(pair);
+                Some((d, d_rank))
+            }
+            Some((d, _)) => {
+                waiting.put(d);
+                Some((pair, rank))
+            }
+            None => Some((pair, rank)),
+        };
+    }
+    Ok(dive.map(|(pair, _)| pair))
 }
