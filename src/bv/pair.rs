@@ -353,6 +353,18 @@ macro_rules! box_pair_methods {
                 .distance_lower_bound_until(enough)
         }
 
+        /// `|t|`, B's centre in A's box frame, is the centres' distance.
+        #[inline]
+        fn distance_lower_bound_and_centres_until(
+            &self,
+            other: &Self,
+            b_to_a: &Pose,
+            enough: f64,
+        ) -> (f64, f64) {
+            let pair = self.pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Metric);
+            (pair.distance_lower_bound_until(enough), pair.t.norm())
+        }
+
         #[inline]
         fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64 {
             self.pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Metric)

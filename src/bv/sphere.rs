@@ -134,6 +134,18 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     }
 
     #[inline]
+    fn distance_lower_bound_and_centres_until(
+        &self,
+        other: &Self,
+        b_to_a: &Pose,
+        _enough: f64,
+    ) -> (f64, f64) {
+        let centres = self.center_distance(other, b_to_a);
+        let bound = (centres - self.radius.to_f64() - other.radius.to_f64()).max(0.0);
+        (bound, centres)
+    }
+
+    #[inline]
     fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64 {
         self.center_distance(other, b_to_a) + self.radius.to_f64() + other.radius.to_f64()
     }

@@ -176,11 +176,21 @@ impl Distance {
 
 impl<B: BoundingVolume> Policy<B> for Distance {
     const ORDERED: bool = true;
-    const DIVE_BY_CENTRES: bool = true;
 
     #[inline]
     fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64 {
         a.distance_lower_bound_until(b, b_to_a, self.prune_at())
+    }
+
+    /// The rank is the mean of the bound and the centres' distance: a bound favours the
+    /// larger of two children, which reaches further, not the one nearer the other model.
+    /// Dives chosen so land nearer the closest pair, whose answer prunes more of what waits
+    /// (README, Benchmarks: `rel_err` 0.01 29% fewer node pairs over 53 poses, touching
+    /// models far fewer).
+    #[inline]
+    fn key_and_rank(&self, a: &B, b: &B, b_to_a: &Pose) -> (f64, f64) {
+        let (bound, centres) = a.distance_lower_bound_and_centres_until(b, b_to_a, self.prune_at());
+        (bound, 0.5 * (bound + centres))
     }
 
     #[inline]

@@ -45,13 +45,13 @@ pub(crate) trait Policy<B: BoundingVolume> {
     fn nearest_first(&self) -> bool {
         false
     }
-    /// Whether a dive of an ordered traversal chooses between two children by the mean of
-    /// their key and the distance between the volumes' centres, rather than by the key
-    /// alone. A distance bound favours the larger box, which reaches further; the centres
-    /// say where the surfaces are. The dive lands nearer the closest pair, and its answer
-    /// prunes more of what waits (README, Benchmarks: `rel_err` 0.01 29% fewer node
-    /// pairs over 53 poses).
-    const DIVE_BY_CENTRES: bool = false;
+    /// The key of a volume pair and the rank a dive of an ordered traversal chooses
+    /// between children by (smaller first): the key itself by default.
+    #[inline]
+    fn key_and_rank(&self, a: &B, b: &B, b_to_a: &Pose) -> (f64, f64) {
+        let key = self.key(a, b, b_to_a);
+        (key, key)
+    }
     /// Tests one triangle pair (A's triangle in A's frame, B's mapped into it).
     /// `face_a` / `face_b` are leaf-ordered face indices.
     fn triangles(
@@ -236,8 +236,8 @@ fn triangle<B: BoundingVolume>(
 /// Unordered policies (collision) go depth first and test a pair when it is taken, as
 /// RAPID's recursion does: a first-contact query that stops never tests the pairs still
 /// waiting. Ordered policies (distance, span) key a pair when it is pushed and dive: each
-/// expansion continues with its most promising child (smallest key, or see
-/// [`Policy::DIVE_BY_CENTRES`]) down to a triangle pair (a first
+/// expansion continues with its most promising child (smallest rank, see
+/// [`Policy::key_and_rank`]) down to a triangle pair (a first
 /// answer to prune with, one step per level), the other children wait on a heap, and the
 /// next dive starts from the smallest key waiting, wherever in the trees it is (up to the
 /// [`Frontier`]'s heap size). The traversal ends as soon as that smallest key is pruned,
@@ -477,8 +477,8 @@ fn push_nearest_last<B: BoundingVolume>(
 ///
 /// An ordered traversal continues with one child at once, the rest wait: a greedy dive
 /// that reaches a triangle pair, and a first answer to prune with, in one step per level.
-/// It takes the child of smaller key, or with [`Policy::DIVE_BY_CENTRES`] of smaller mean
-/// of key and centre distance. An ordered policy's pair whose key is refused is counted as
+/// It takes the child of smaller rank ([`Policy::key_and_rank`]). An ordered policy's pair
+/// whose key is refused is counted as
 /// a pruned pair and dropped rather than put waiting: the best answer only
 /// improves, so it would be refused when taken too, and a heap push and pop cost more
 /// than its key (bunny–fandisk, exact distance: a fifth of the pairs, with `rel_err` 0.01
@@ -502,25 +502,21 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
         }
         return Ok(None);
     }
-    // The pair a dive continues with, and what it was chosen by.
+    // The pair a dive continues with, and its rank.
     let mut dive: Option<(Pending, f64)> = None;
-    let other_centre = P::DIVE_BY_CENTRES.then(|| step.other_centre(b_to_a));
     for c in step.children.clone() {
         let child = step.child(c)?;
-        let key = ordered_key(match step.side {
-            Side::A => policy.key(&child.bv, step.other_bv, b_to_a),
-            Side::B => policy.key(step.other_bv, &child.bv, b_to_a),
-        });
+        let (key, rank) = match step.side {
+            Side::A => policy.key_and_rank(&child.bv, step.other_bv, b_to_a),
+            Side::B => policy.key_and_rank(step.other_bv, &child.bv, b_to_a),
+        };
+        let (key, rank) = (ordered_key(key), ordered_key(rank));
         if !policy.keep(key) {
             stats.nodes_visited += 1;
             stats.bv_disjoint += 1;
             continue;
         }
         let pair = step.pair(c, key);
-        let rank = match other_centre {
-            Some(other) => 0.5 * (key + (step.child_centre(c, b_to_a)? - other).norm()),
-            None => key,
-        };
         dive = match dive {
             Some((d, d_rank)) if d_rank <= rank => {
                 waiting.put(pair);
