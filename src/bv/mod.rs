@@ -210,14 +210,7 @@ pub trait BoundingVolume:
         other: &Self,
         b_to_a: &Pose,
         enough: f64,
-    ) -> (f64, f64) {
-        let centre_b = b_to_a.apply(&Vector3::from(other.center()));
-        let centres = (centre_b - Vector3::from(self.center())).norm();
-        (
-            self.distance_lower_bound_until(other, b_to_a, enough),
-            centres,
-        )
-    }
+    ) -> (f64, f64);
 
     /// An upper bound on the largest distance between a point of this volume and a point of
     /// `other` (posed as in [`BoundingVolume::overlaps`]).
