@@ -35,17 +35,20 @@ pub(crate) fn max(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// Componentwise extremes `(min, max)` of `points` (zeros for none).
-pub(crate) fn bounds(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    if points.is_empty() {
-        return ([0.0; 3], [0.0; 3]);
-    }
+pub(crate) fn bounds<'a>(points: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
+    let mut any = false;
     for p in points {
         lo = min(lo, *p);
         hi = max(hi, *p);
+        any = true;
     }
-    (lo, hi)
+    if any {
+        (lo, hi)
+    } else {
+        ([0.0; 3], [0.0; 3])
+    }
 }
 
 /// Rows become columns.

@@ -161,8 +161,7 @@ pub trait BoundingVolume:
         positions: &[[f64; 3]],
         vertices: &[u32],
     ) -> [(Matrix3<f64>, Self); 2] {
-        let points: Vec<[f64; 3]> = listed_vertices(positions, vertices).copied().collect();
-        let (lo, hi) = arr3::bounds(&points);
+        let (lo, hi) = arr3::bounds(listed_vertices(positions, vertices));
         let model = model_axes_frame(lo, hi);
         [
             (*axes, Self::enclose_vertices(axes, positions, vertices)),

@@ -128,9 +128,9 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     }
 
     #[inline]
-    fn distance_lower_bound_until(&self, other: &Self, b_to_a: &Pose, _enough: f64) -> f64 {
-        (self.center_distance(other, b_to_a) - self.radius.to_f64() - other.radius.to_f64())
-            .max(0.0)
+    fn distance_lower_bound_until(&self, other: &Self, b_to_a: &Pose, enough: f64) -> f64 {
+        self.distance_lower_bound_and_centres_until(other, b_to_a, enough)
+            .0
     }
 
     #[inline]

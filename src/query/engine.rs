@@ -477,12 +477,11 @@ fn push_nearest_last<B: BoundingVolume>(
 ///
 /// An ordered traversal continues with one child at once, the rest wait: a greedy dive
 /// that reaches a triangle pair, and a first answer to prune with, in one step per level.
-/// It takes the child of smaller rank ([`Policy::key_and_rank`]). An ordered policy's pair
-/// whose key is refused is counted as
-/// a pruned pair and dropped rather than put waiting: the best answer only
-/// improves, so it would be refused when taken too, and a heap push and pop cost more
-/// than its key (bunny–fandisk, exact distance: a fifth of the pairs, with `rel_err` 0.01
-/// half).
+/// It takes the child of smaller rank ([`Policy::key_and_rank`]). A pair whose key is
+/// refused is counted as a pruned pair and dropped rather than put waiting: the best
+/// answer only improves, so it would be refused when taken too, and a heap push and pop
+/// cost more than its key (bunny–fandisk, exact distance: a fifth of the pairs, with
+/// `rel_err` 0.01 half).
 #[inline(always)]
 fn push_children<B: BoundingVolume, P: Policy<B>>(
     step: &Step<'_, '_, B>,
