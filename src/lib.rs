@@ -87,6 +87,7 @@ pub mod build;
 pub mod bv;
 pub mod fit;
 pub mod format;
+pub mod generate;
 pub mod mesh;
 pub mod placement;
 mod pose;

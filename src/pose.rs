@@ -283,6 +283,15 @@ impl Pose {
         Ok(PoseFormat::RotationTranslation.parse(values, false)?.pose)
     }
 
+    /// The 12 numbers [`Pose::from_row_major`] reads: the rotation row by row, then the
+    /// translation.
+    pub fn row_major(&self) -> [f64; 12] {
+        let (r, t) = (&self.rotation, &self.translation);
+        [
+            r.m11, r.m12, r.m13, r.m21, r.m22, r.m23, r.m31, r.m32, r.m33, t.x, t.y, t.z,
+        ]
+    }
+
     /// A pose from a unit quaternion and a translation (world units). nalgebra keeps
     /// `UnitQuaternion` normalised, so only non-finite numbers are refused.
     pub fn from_quaternion(

@@ -111,6 +111,12 @@ impl TriMesh {
         &self.faces
     }
 
+    /// The mesh as OBJ text, which [`TriMesh::load`] reads back to the same mesh: the same
+    /// vertices bit for bit, the same faces and triangle ids.
+    pub fn to_obj(&self) -> String {
+        obj::write(self)
+    }
+
     /// Number of zero-area triangles: a repeated vertex index, or coincident or
     /// collinear positions (an exactly zero cross product in f64). They are
     /// kept in the mesh because they can still touch other geometry.

@@ -19,6 +19,23 @@ use super::error::{quote, shorten};
 use super::text::{coordinate, decode, numbered_lines};
 use super::{Location, MeshError, Place, TriMesh, MAX_TRIANGLES, MAX_VERTICES};
 
+/// `mesh` as OBJ text: one `v` line per vertex (each coordinate with the fewest digits
+/// that read back exactly) and one 1-based `f` line per face, in order, so that
+/// [`parse`] gives the same mesh back, ids and all.
+pub(crate) fn write(mesh: &TriMesh) -> String {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    // Writing to a String cannot fail.
+    for [x, y, z] in mesh.vertices() {
+        let _ = writeln!(text, "v {x:?} {y:?} {z:?}");
+    }
+    for face in mesh.faces() {
+        let [a, b, c] = face.map(|v| u64::from(v).saturating_add(1));
+        let _ = writeln!(text, "f {a} {b} {c}");
+    }
+    text
+}
+
 /// Parses OBJ text; `file` names it in errors.
 pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<TriMesh, MeshError> {
     let text = decode(bytes);

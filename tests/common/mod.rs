@@ -14,35 +14,7 @@ use obbtree::mesh::TriMesh;
 /// A latitude/longitude sphere of `2 * slices * (stacks - 1)` triangles, like the spheres of
 /// the dissertation's §5.3.1 scene.
 pub fn uv_sphere(radius: f64, stacks: u32, slices: u32) -> TriMesh {
-    let mut vertices = vec![[0.0, 0.0, radius]];
-    for i in 1..stacks {
-        let theta = std::f64::consts::PI * f64::from(i) / f64::from(stacks);
-        for j in 0..slices {
-            let phi = 2.0 * std::f64::consts::PI * f64::from(j) / f64::from(slices);
-            vertices.push([
-                radius * theta.sin() * phi.cos(),
-                radius * theta.sin() * phi.sin(),
-                radius * theta.cos(),
-            ]);
-        }
-    }
-    vertices.push([0.0, 0.0, -radius]);
-    let south = vertices.len() as u32 - 1;
-    let ring = |i: u32, j: u32| 1 + (i - 1) * slices + (j % slices);
-    let mut faces = Vec::new();
-    for j in 0..slices {
-        faces.push([0, ring(1, j), ring(1, j + 1)]);
-    }
-    for i in 1..stacks - 1 {
-        for j in 0..slices {
-            faces.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
-            faces.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
-        }
-    }
-    for j in 0..slices {
-        faces.push([ring(stacks - 1, j), south, ring(stacks - 1, j + 1)]);
-    }
-    TriMesh::new(vertices, faces).expect("valid sphere")
+    obbtree::generate::lat_long_sphere(radius, stacks, slices).expect("valid sphere")
 }
 
 /// The axis-aligned cube `[-h, h]^3`, 12 triangles.
@@ -53,32 +25,7 @@ pub fn cube(h: f64) -> TriMesh {
 /// The axis-aligned box with half-widths `half` centred at `center`, 12 triangles, outward
 /// normals. Corner `i` has the upper coordinate on axis `k` when bit `k` of `i` is set.
 pub fn cuboid(half: [f64; 3], center: [f64; 3]) -> TriMesh {
-    let v: Vec<[f64; 3]> = (0..8)
-        .map(|i| {
-            std::array::from_fn(|k| {
-                if i & (1 << k) == 0 {
-                    center[k] - half[k]
-                } else {
-                    center[k] + half[k]
-                }
-            })
-        })
-        .collect();
-    let faces = vec![
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
-    TriMesh::new(v, faces).expect("valid cuboid")
+    obbtree::generate::cuboid(half, center).expect("valid cuboid")
 }
 
 /// A flat `n x n` grid of unit squares in the plane z = 0, `2 n^2` triangles.
@@ -103,15 +50,7 @@ pub fn grid(n: u32) -> TriMesh {
 /// `mesh` as OBJ text: `v` lines (shortest decimals that read back exactly) and 1-based
 /// `f` lines, in order.
 pub fn obj_text(mesh: &TriMesh) -> String {
-    use std::fmt::Write as _;
-    let mut text = String::new();
-    for v in mesh.vertices() {
-        writeln!(text, "v {} {} {}", v[0], v[1], v[2]).unwrap();
-    }
-    for f in mesh.faces() {
-        writeln!(text, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1).unwrap();
-    }
-    text
+    mesh.to_obj()
 }
 
 /// The bundled cow (5,804 triangles), loaded from `assets/`.
