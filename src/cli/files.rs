@@ -23,6 +23,22 @@ pub fn is_obbt(path: &Path) -> bool {
 /// Refuses to write `output` when it is one of `inputs`, or when it exists, is not a
 /// `.obbt` file and `force` is off.
 pub fn check_output(output: &Path, inputs: &[&Path], force: bool) -> Result<(), Failure> {
+    check(output, inputs, |output| force || is_obbt(output))
+}
+
+/// Refuses to write `output` (a generated mesh or pose file) when it exists and `force`
+/// is off.
+pub fn check_new_output(output: &Path, force: bool) -> Result<(), Failure> {
+    check(output, &[], |_| force)
+}
+
+/// Refuses `output` when it is one of `inputs`, is a directory, or exists and may not be
+/// replaced.
+fn check(
+    output: &Path,
+    inputs: &[&Path],
+    may_replace: impl Fn(&Path) -> bool,
+) -> Result<(), Failure> {
     let shown = output.display();
     for input in inputs {
         if same_file::is_same_file(input, output).unwrap_or(false) {
@@ -36,7 +52,10 @@ pub fn check_output(output: &Path, inputs: &[&Path], force: bool) -> Result<(), 
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
         Err(e) => Err(Failure(format!("{shown}: cannot check the output: {e}"))),
         Ok(m) if m.is_dir() => Err(Failure(format!("{shown}: is a directory"))),
-        Ok(_) if is_obbt(output) || force => Ok(()),
+        Ok(_) if may_replace(output) => Ok(()),
+        Ok(_) if inputs.is_empty() => Err(Failure(format!(
+            "{shown}: exists; refusing to replace it (use --force)"
+        ))),
         Ok(_) => Err(Failure(format!(
             "{shown}: exists and is not an .obbt file; refusing to replace it (use --force)"
         ))),

@@ -4,6 +4,7 @@
 mod build;
 mod demo;
 mod files;
+mod generate;
 mod info;
 mod poses;
 mod print;
@@ -41,6 +42,8 @@ enum Command {
     Span(query::SpanArgs),
     Scene(scene::SceneArgs),
     Demo(demo::DemoArgs),
+    Mesh(generate::MeshArgs),
+    Poses(generate::PosesArgs),
 }
 
 /// A failure to report: one line, exit status 1.
@@ -66,6 +69,8 @@ pub fn main() -> ExitCode {
         Command::Span(args) => query::span(&args),
         Command::Scene(args) => scene::run(&args).map(|_| ()),
         Command::Demo(args) => demo::run(&args),
+        Command::Mesh(args) => generate::mesh(&args),
+        Command::Poses(args) => generate::poses(&args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
