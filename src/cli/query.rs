@@ -30,9 +30,24 @@ pub struct QueryInputs {
     /// A or B.
     #[arg(long, value_enum, default_value_t = RuleArg::Diameter)]
     pub rule: RuleArg,
-    /// Print JSON (one object; a batch always prints JSON lines).
-    #[arg(long)]
+    /// Print JSON (one object; a batch prints JSON lines unless --csv).
+    #[arg(long, conflicts_with = "csv")]
     pub json: bool,
+    /// Print CSV: a header, then one row per pose with the answer, the work (D, I, S, K as
+    /// in the dissertation, bv_tests = D + I, tri_tests = S + K; for all-pairs collision
+    /// also the least number of box tests that can find its contacts, §2.6.3) and the
+    /// time.
+    #[arg(long)]
+    pub csv: bool,
+    /// Run each query K times and report the median time (the answer is the same each
+    /// time).
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub repeat: u32,
+    /// Threads that run a batch's poses [default: one per core]. Times measured while
+    /// other threads work are inflated (1.5x seen with sphere trees on two cores): take
+    /// timings with --threads 1.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..1025))]
+    pub threads: Option<u32>,
     /// How mesh inputs are built in memory. They do not apply to .obbt inputs (given with
     /// two .obbt inputs they are refused), and a mesh paired with a .obbt file is built
     /// with that file's volume and precision.
@@ -192,7 +207,38 @@ fn stats_json(s: &Stats) -> Value {
         "tri_separated": s.tri_separated,
         "tri_contact": s.tri_contact,
         "nodes_visited": s.nodes_visited,
+        "bv_tests": s.bv_disjoint + s.bv_overlap,
+        "tri_tests": s.tri_separated + s.tri_contact,
     })
+}
+
+/// The least number of box tests that can locate `contacts` contacting pairs among the
+/// `cells` triangle pairs of two models (dissertation §2.6.3: ideal volumes, balanced
+/// trees, the contacts in one block): `2 log2(cells / k) + 2k − 1`, for `k > 0`.
+fn bv_test_lower_bound(cells: f64, contacts: usize) -> Option<f64> {
+    let k = contacts as f64;
+    (contacts > 0).then(|| 2.0 * (cells / k).log2() + 2.0 * k - 1.0)
+}
+
+/// Runs `query` `repeat` times: its last answer, and the median time of one run.
+fn timed<T>(
+    repeat: u32,
+    mut query: impl FnMut() -> Result<T, obbtree::query::QueryError>,
+) -> Result<(T, f64), Failure> {
+    let mut times = Vec::with_capacity(repeat as usize);
+    let mut answer = None;
+    for _ in 0..repeat.max(1) {
+        let started = Instant::now();
+        let r = query()?;
+        times.push(started.elapsed().as_secs_f64());
+        answer = Some(r);
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times.get(times.len() / 2).copied().unwrap_or(0.0);
+    match answer {
+        Some(r) => Ok((r, median)),
+        None => Err(Failure("no query ran".into())),
+    }
 }
 
 fn stats_text(s: &Stats) -> String {
@@ -238,37 +284,92 @@ fn insert(value: &mut Value, key: &str, item: Value) {
 /// One query under one pose pair: its JSON object and its human-readable text.
 type Answer = (Value, String);
 
-/// Runs `query` once, or over the batch in parallel, and prints the answers.
-fn run_query<F>(inputs: &QueryInputs, query: F) -> Result<(), Failure>
+/// The CSV columns of a command: JSON pointers into its answers (the header is each
+/// pointer's last part). Every command's rows also start with the pose and end with the
+/// work and the time.
+fn csv_columns(answer: &[&'static str]) -> Vec<&'static str> {
+    let mut columns = vec!["/pose"];
+    columns.extend_from_slice(answer);
+    columns.extend_from_slice(&[
+        "/stats/bv_disjoint",
+        "/stats/bv_overlap",
+        "/stats/tri_separated",
+        "/stats/tri_contact",
+        "/stats/bv_tests",
+        "/stats/tri_tests",
+        "/stats/nodes_visited",
+        "/seconds",
+    ]);
+    columns
+}
+
+/// One CSV field: numbers and booleans as JSON prints them, null as empty.
+fn csv_field(value: Option<&Value>) -> String {
+    match value {
+        None | Some(Value::Null) => String::new(),
+        Some(Value::String(text)) => text.clone(),
+        Some(other) => other.to_string(),
+    }
+}
+
+/// Runs `query` once, or over the batch in parallel, and prints the answers as text, JSON
+/// or CSV (`columns`, see [`csv_columns`]).
+fn run_query<F>(inputs: &QueryInputs, columns: &[&str], query: F) -> Result<(), Failure>
 where
     F: Fn(&Pose, &Pose, &mut QueryContext) -> Result<Answer, Failure> + Sync,
 {
-    match inputs.poses.batch()? {
-        None => {
-            let (a, b) = inputs.poses.single()?;
-            let (value, text) = query(&a, &b, &mut QueryContext::new())?;
-            if inputs.json {
-                out!("{value}")?;
-            } else {
-                out!("{text}")?;
-            }
-        }
-        Some(batch) => {
-            let answers: Vec<Result<Value, Failure>> = batch
-                .par_iter()
-                .map_init(QueryContext::new, |context, (a, b)| {
-                    query(a, b, context).map(|(v, _)| v)
-                })
+    let batch = inputs.poses.batch()?;
+    if inputs.csv {
+        let header: Vec<&str> = columns
+            .iter()
+            .map(|c| c.rsplit('/').next().unwrap_or(c))
+            .collect();
+        out!("{}", header.join(","))?;
+    }
+    let print = |index: usize, mut value: Value| -> Result<(), Failure> {
+        insert(&mut value, "pose", json!(index));
+        if inputs.csv {
+            let row: Vec<String> = columns
+                .iter()
+                .map(|c| csv_field(value.pointer(c)))
                 .collect();
-            for (index, answer) in answers.into_iter().enumerate() {
-                if print::closed() {
-                    break;
-                }
-                let mut value = answer?;
-                insert(&mut value, "pose", json!(index));
-                out!("{value}")?;
-            }
+            out!("{}", row.join(","))
+        } else {
+            out!("{value}")
         }
+    };
+    let Some(batch) = batch else {
+        let (a, b) = inputs.poses.single()?;
+        let (value, text) = query(&a, &b, &mut QueryContext::new())?;
+        return if inputs.csv {
+            print(0, value)
+        } else if inputs.json {
+            out!("{value}")
+        } else {
+            out!("{text}")
+        };
+    };
+    let run = || -> Vec<Result<Value, Failure>> {
+        batch
+            .par_iter()
+            .map_init(QueryContext::new, |context, (a, b)| {
+                query(a, b, context).map(|(v, _)| v)
+            })
+            .collect()
+    };
+    let answers = match inputs.threads {
+        None => run(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .map_err(|e| Failure(format!("--threads {n}: {e}")))?
+            .install(run),
+    };
+    for (index, answer) in answers.into_iter().enumerate() {
+        if print::closed() {
+            break;
+        }
+        print(index, answer?)?;
     }
     Ok(())
 }
@@ -280,13 +381,17 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
         rule: args.inputs.rule.rule(),
         ..CollideOptions::default()
     };
-    run_query(&args.inputs, |pa, pb, context| {
-        let started = Instant::now();
-        let r = collide_files(&a, pa, &b, pb, &options, context)?;
-        let seconds = started.elapsed().as_secs_f64();
+    let cells = f64::from(a.info().triangles) * f64::from(b.info().triangles);
+    let columns = csv_columns(&["/colliding", "/contacts", "/bv_test_lower_bound"]);
+    let repeat = args.inputs.repeat;
+    run_query(&args.inputs, &columns, |pa, pb, context| {
+        let (r, seconds) = timed(repeat, || collide_files(&a, pa, &b, pb, &options, context))?;
+        // (A first-contact query finds one contact, not all: no bound applies.)
+        let bound = bv_test_lower_bound(cells, r.pairs.len()).filter(|_| !args.first);
         let mut value = json!({
             "colliding": r.colliding,
             "contacts": r.pairs.len(),
+            "bv_test_lower_bound": bound,
             "stats": stats_json(&r.stats),
             "seconds": seconds,
         });
@@ -325,11 +430,23 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         rule,
         ..DistanceOptions::default()
     };
-    run_query(&args.inputs, |pa, pb, context| {
-        let started = Instant::now();
+    let columns = csv_columns(if args.tolerance.is_some() {
+        &[
+            "/closer_than_tolerance",
+            "/tolerance",
+            "/distance",
+            "/tri_a",
+            "/tri_b",
+        ]
+    } else {
+        &["/distance", "/tri_a", "/tri_b"]
+    });
+    let repeat = args.inputs.repeat;
+    run_query(&args.inputs, &columns, |pa, pb, context| {
         if let Some(t) = args.tolerance {
-            let r = within_tolerance_files(&a, pa, &b, pb, t, rule, context)?;
-            let seconds = started.elapsed().as_secs_f64();
+            let (r, seconds) = timed(repeat, || {
+                within_tolerance_files(&a, pa, &b, pb, t, rule, context)
+            })?;
             let w = r.witness.as_ref();
             let value = json!({
                 "closer_than_tolerance": r.closer,
@@ -357,8 +474,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
             };
             return Ok((value, text));
         }
-        let r = distance_files(&a, pa, &b, pb, &options, context)?;
-        let seconds = started.elapsed().as_secs_f64();
+        let (r, seconds) = timed(repeat, || distance_files(&a, pa, &b, pb, &options, context))?;
         let value = witness_json(
             "distance",
             r.distance,
@@ -383,10 +499,10 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
 pub fn span(args: &SpanArgs) -> Result<(), Failure> {
     let (a, b) = open_pair(&args.inputs)?;
     let rule = args.inputs.rule.rule();
-    run_query(&args.inputs, |pa, pb, context| {
-        let started = Instant::now();
-        let r = span_files(&a, pa, &b, pb, rule, context)?;
-        let seconds = started.elapsed().as_secs_f64();
+    let columns = csv_columns(&["/span", "/tri_a", "/tri_b"]);
+    let repeat = args.inputs.repeat;
+    run_query(&args.inputs, &columns, |pa, pb, context| {
+        let (r, seconds) = timed(repeat, || span_files(&a, pa, &b, pb, rule, context))?;
         let value = witness_json(
             "span",
             r.span,
