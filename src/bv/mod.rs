@@ -231,6 +231,9 @@ pub trait BoundingVolume:
 
     /// Largest distance between two points of the volume (model units).
     fn diameter(&self) -> f64;
+    /// Smallest width of the volume (model units): a box's smallest side, a sphere's
+    /// diameter. How flat a node's volume is (dissertation Fig. 5.17).
+    fn thickness(&self) -> f64;
     /// Enclosed volume (cubic model units).
     fn volume(&self) -> f64;
     /// Surface area (square model units).

@@ -395,6 +395,11 @@ macro_rules! box_pair_methods {
             $crate::bv::obb::box_measures(self.half_f64()).0
         }
 
+        fn thickness(&self) -> f64 {
+            let [x, y, z] = self.half_f64();
+            2.0 * x.min(y).min(z)
+        }
+
         fn volume(&self) -> f64 {
             $crate::bv::obb::box_measures(self.half_f64()).1
         }

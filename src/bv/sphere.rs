@@ -173,6 +173,9 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     fn diameter(&self) -> f64 {
         2.0 * self.radius.to_f64()
     }
+    fn thickness(&self) -> f64 {
+        self.diameter()
+    }
     fn volume(&self) -> f64 {
         4.0 / 3.0 * std::f64::consts::PI * self.radius.to_f64().powi(3)
     }

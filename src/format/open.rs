@@ -11,7 +11,7 @@ use crate::bv::{with_volume_type, BoundingVolume, BvKind, Node};
 use crate::fit::FitMethod;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
-use crate::stats::{TreeShape, TreeStats};
+use crate::stats::{level_stats, LevelStats, TreeShape, TreeStats};
 use crate::tree::{Encoding, TreeView, VARIABLE_MAX_LEAF_FACES};
 use std::ops::Range;
 use std::path::Path;
@@ -247,6 +247,16 @@ impl ObbtFile {
     /// volume containing the vertices below it.
     pub fn verify(&self) -> Result<(), VerifyError> {
         super::verify::verify(self)
+    }
+
+    /// The tree's volumes measured level by level, root first ([`LevelStats`]). Reads every
+    /// node; a damaged, unverified file gives the first defect met.
+    pub fn level_stats(&self) -> Result<Vec<LevelStats>, VerifyError> {
+        let nodes = |problem: String| VerifyError::new("section nodes", problem);
+        with_volume_type!(self.bv_kind(), self.precision(), B => {
+            let view = self.view::<B>().map_err(|e| nodes(e.to_string()))?;
+            level_stats(&view).map_err(|d| nodes(d.to_string()))
+        })
     }
 
     /// Writes the image to `path` atomically (temporary file in the same directory, fsync,
