@@ -85,6 +85,7 @@ pub use nalgebra;
 mod arr3;
 pub mod build;
 pub mod bv;
+pub mod experiment;
 pub mod fit;
 pub mod format;
 pub mod generate;

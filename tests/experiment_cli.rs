@@ -18,8 +18,11 @@ fn path(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// A CSV row: header to field.
+type Row = HashMap<String, String>;
+
 /// CSV rows as maps from header to field.
-fn rows(csv: &str) -> Vec<HashMap<String, String>> {
+fn rows(csv: &str) -> Vec<Row> {
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
     lines
@@ -35,7 +38,7 @@ fn rows(csv: &str) -> Vec<HashMap<String, String>> {
         .collect()
 }
 
-fn int(row: &HashMap<String, String>, key: &str) -> i64 {
+fn int(row: &Row, key: &str) -> i64 {
     row[key]
         .parse()
         .unwrap_or_else(|_| panic!("{key} = {:?}", row[key]))
@@ -329,4 +332,133 @@ fn generators_replay_from_their_seed_and_refuse_bad_requests_in_one_line() {
         "--quiet",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Runs `obbtree experiment NAME --quick` into a scratch directory: the rows of its CSV
+/// and, if it fits lines, the rows of its fits CSV.
+fn quick_experiment(name: &str) -> (Vec<Row>, Vec<Row>, String) {
+    let dir = scratch(&format!("experiment-{name}"));
+    let stdout = run(&["experiment", name, "--quick", "--out", path(&dir)]);
+    let points = rows(&std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap());
+    let fits = std::fs::read_to_string(dir.join(format!("{name}-fits.csv")))
+        .map(|text| rows(&text))
+        .unwrap_or_default();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let file = entry.unwrap().path();
+        if file.extension().is_some_and(|e| e == "svg") {
+            let svg = std::fs::read_to_string(&file).unwrap();
+            assert!(
+                svg.starts_with("<svg") && svg.contains("</svg>"),
+                "{}",
+                file.display()
+            );
+        }
+    }
+    (points, fits, stdout)
+}
+
+fn float(row: &Row, key: &str) -> f64 {
+    row[key]
+        .parse()
+        .unwrap_or_else(|_| panic!("{key} = {:?}", row[key]))
+}
+
+/// Every row of every experiment: the BVTT identity holds for its mean counts (it holds
+/// for each query, and it is linear), no row makes fewer volume tests than the §2.6.3
+/// bound, and the three volume types find the same contacts at every point.
+fn check_rows(name: &str, points: &[Row]) {
+    let mut contacts: HashMap<String, Vec<String>> = HashMap::new();
+    for row in points {
+        let identity = float(row, "bv_disjoint") - float(row, "bv_overlap")
+            + 2.0 * float(row, "tri_separated")
+            + 2.0 * float(row, "tri_contact");
+        assert!((identity - 1.0).abs() < 1e-9, "{name}: {row:?}");
+        assert!(
+            float(row, "bv_tests") + 1e-9 >= float(row, "bv_test_lower_bound"),
+            "{name}: {row:?}"
+        );
+        assert!(float(row, "queries") >= 1.0);
+        contacts
+            .entry(row["bv"].clone())
+            .or_default()
+            .push(row["contacts"].clone());
+    }
+    assert_eq!(contacts.len(), 3, "{name}: three volume types");
+    assert_eq!(contacts["obb"], contacts["aabb"], "{name}");
+    assert_eq!(contacts["obb"], contacts["sphere"], "{name}");
+}
+
+fn slope(fits: &[Row], bv: &str, measure: &str) -> f64 {
+    let fit = fits
+        .iter()
+        .find(|f| f["bv"] == bv && f["measure"] == measure)
+        .unwrap_or_else(|| panic!("no {bv} {measure} fit in {fits:?}"));
+    float(fit, "slope")
+}
+
+#[test]
+fn quick_sliding_spheres_touch_from_0_2_to_1_8_and_obbs_prune_most() {
+    let (points, _, stdout) = quick_experiment("sliding");
+    check_rows("sliding", &points);
+    assert_eq!(points.len(), 3 * 101);
+    let touching: Vec<f64> = points
+        .iter()
+        .filter(|r| r["bv"] == "obb" && float(r, "contacts") > 0.0)
+        .map(|r| float(r, "x"))
+        .collect();
+    assert!((0.18..=0.22).contains(&touching[0]), "{touching:?}");
+    assert!(
+        (1.76..=1.8).contains(touching.last().unwrap()),
+        "{touching:?}"
+    );
+    // In contact, AABB and sphere trees test more volumes than OBB trees at every step.
+    let tests = |bv: &str| -> Vec<f64> {
+        points
+            .iter()
+            .filter(|r| r["bv"] == bv)
+            .map(|r| float(r, "bv_tests"))
+            .collect()
+    };
+    let (obb, aabb, sphere) = (tests("obb"), tests("aabb"), tests("sphere"));
+    for (k, r) in points.iter().filter(|r| r["bv"] == "obb").enumerate() {
+        if float(r, "contacts") > 0.0 {
+            assert!(aabb[k] > obb[k] && sphere[k] > obb[k], "x = {}", r["x"]);
+        }
+    }
+    assert!(
+        stdout.contains("measured against the dissertation"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn quick_parallel_close_proximity_has_the_dissertations_slopes() {
+    let (points, fits, stdout) = quick_experiment("proximity");
+    check_rows("proximity", &points);
+    let obb = slope(&fits, "obb", "bv_tests");
+    assert!((-1.3..=-1.0).contains(&obb), "OBB slope {obb}");
+    for bv in ["aabb", "sphere"] {
+        let s = slope(&fits, bv, "bv_tests");
+        assert!((-2.3..=-1.7).contains(&s), "{bv} slope {s}");
+    }
+    // The right ledge: 15 tests for OBBs, as §5.3.2.1 reports.
+    let fewest = points
+        .iter()
+        .filter(|r| r["bv"] == "obb")
+        .map(|r| float(r, "bv_tests"))
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(fewest, 15.0);
+    assert!(stdout.contains("ramp slope"), "{stdout}");
+}
+
+#[test]
+fn quick_transverse_contact_grows_as_the_square_root_of_the_tessellation() {
+    let (points, fits, _) = quick_experiment("transverse");
+    check_rows("transverse", &points);
+    for bv in ["obb", "aabb", "sphere"] {
+        for measure in ["contacts", "bv_tests"] {
+            let s = slope(&fits, bv, measure);
+            assert!((0.4..=0.6).contains(&s), "{bv} {measure} slope {s}");
+        }
+    }
 }

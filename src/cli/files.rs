@@ -62,6 +62,14 @@ fn check(
     }
 }
 
+/// Writes `bytes` to `path` atomically (nothing partial is ever left behind, and the
+/// temporaries of an earlier writer that was killed are removed first).
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Failure> {
+    let _ = obbtree::format::remove_stale_temporaries(path);
+    obbtree::format::write_atomic(path, bytes)
+        .map_err(|e| Failure(format!("{}: cannot write: {e}", path.display())))
+}
+
 /// Makes Ctrl-C, SIGTERM and SIGHUP remove unfinished temporary files and exit with 130.
 pub fn handle_interrupts() {
     // Fails only if a handler is already set (never, in this binary); the default

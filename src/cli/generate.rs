@@ -1,11 +1,10 @@
 //! `obbtree mesh` and `obbtree poses`: the shapes and pose batches of experiments, written
 //! as files every other command reads.
 
-use super::files::check_new_output;
+use super::files::{check_new_output, write_file as write};
 use super::print::out;
 use super::Failure;
 use clap::{Args, Subcommand, ValueEnum};
-use obbtree::format::{remove_stale_temporaries, write_atomic};
 use obbtree::generate::{
     cuboid, lat_long_sphere, plate, pose_line, random_poses, sweep, Axis, PosePair, Sweep,
     SweepRotation,
@@ -241,11 +240,4 @@ pub fn poses(args: &PosesArgs) -> Result<(), Failure> {
         }
     }
     Ok(())
-}
-
-/// Writes `bytes` to `output` atomically (nothing partial is ever left behind).
-fn write(output: &Path, bytes: &[u8]) -> Result<(), Failure> {
-    let _ = remove_stale_temporaries(output);
-    write_atomic(output, bytes)
-        .map_err(|e| Failure(format!("{}: cannot write: {e}", output.display())))
 }

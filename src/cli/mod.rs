@@ -3,9 +3,11 @@
 
 mod build;
 mod demo;
+mod experiment;
 mod files;
 mod generate;
 mod info;
+mod plot;
 mod poses;
 mod print;
 mod query;
@@ -42,6 +44,7 @@ enum Command {
     Span(query::SpanArgs),
     Scene(scene::SceneArgs),
     Demo(demo::DemoArgs),
+    Experiment(experiment::ExperimentArgs),
     Mesh(generate::MeshArgs),
     Poses(generate::PosesArgs),
 }
@@ -69,6 +72,7 @@ pub fn main() -> ExitCode {
         Command::Span(args) => query::span(&args),
         Command::Scene(args) => scene::run(&args).map(|_| ()),
         Command::Demo(args) => demo::run(&args),
+        Command::Experiment(args) => experiment::run(&args),
         Command::Mesh(args) => generate::mesh(&args),
         Command::Poses(args) => generate::poses(&args),
     };

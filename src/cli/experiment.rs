@@ -1,0 +1,360 @@
+//! `obbtree experiment`: the dissertation's chapter 5 experiments, run end to end, with
+//! their CSV files, plots and a table of measured against reported figures.
+
+use super::files::write_file;
+use super::plot::{self, Chart, Series};
+use super::print::out;
+use super::{human_seconds, Failure};
+use clap::{Args, ValueEnum};
+use obbtree::bv::BvKind;
+use obbtree::experiment::{self, of_kind, Outcome, Point, Size};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Run an experiment of the dissertation's chapter 5 for OBB, AABB and sphere trees, and
+/// write its CSV, its plots (SVG) and a table of measured against reported figures.
+///
+/// sliding: a sphere of radius 0.8 slides through a unit sphere (§5.3.1), both turned at
+/// random at each of 1,001 steps; all contacts found at each step.
+/// proximity: a unit sphere inside a sphere of radius 1 + gap (§5.3.2), gaps from 1 to
+/// 1e-7; the slope of volume tests against the gap on log-log axes.
+/// transverse: two unit spheres meeting at right angles (§5.3.3.1), 80 to 600,000
+/// triangles; how contacts and volume tests grow with the tessellation.
+///
+/// Queries run in parallel over --threads (default: one per core); the counts do not
+/// depend on it, the times do (take them with --threads 1).
+///
+/// Example: obbtree experiment sliding --quick --out results
+#[derive(Args, Debug)]
+pub struct ExperimentArgs {
+    /// Which experiment.
+    #[arg(value_enum)]
+    pub experiment: ExperimentArg,
+    /// A reduced size that runs in seconds (smaller spheres, fewer steps and queries).
+    #[arg(long)]
+    pub quick: bool,
+    /// Directory for the CSV and SVG files (created if needed; files of the same names
+    /// are replaced).
+    #[arg(long, value_name = "DIR", default_value = "experiments")]
+    pub out: PathBuf,
+    /// Seed of the random orientations.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Threads that run the queries [default: one per core].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..1025))]
+    pub threads: Option<u32>,
+}
+
+/// The experiments.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum ExperimentArg {
+    /// Sliding spheres (§5.3.1).
+    Sliding,
+    /// Parallel close proximity (§5.3.2).
+    Proximity,
+    /// Transverse contact against tessellation (§5.3.3.1).
+    Transverse,
+}
+
+pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
+    let size = if args.quick { Size::Quick } else { Size::Full };
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(Failure(format!(
+            "{}: is not a directory",
+            args.out.display()
+        )));
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| Failure(format!("{}: cannot create: {e}", args.out.display())))?;
+    let started = Instant::now();
+    let experiment = || match args.experiment {
+        ExperimentArg::Sliding => experiment::sliding::run(size, args.seed),
+        ExperimentArg::Proximity => experiment::proximity::run(size, args.seed),
+        ExperimentArg::Transverse => experiment::transverse::run(size, args.seed),
+    };
+    eprintln!(
+        "running {:?}{} ...",
+        args.experiment,
+        if args.quick { " (quick)" } else { "" }
+    );
+    let outcome = match args.threads {
+        None => experiment(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .map_err(|e| Failure(format!("--threads {n}: {e}")))?
+            .install(experiment),
+    }?;
+    let seconds = started.elapsed().as_secs_f64();
+    let mut written = vec![write_csv(&outcome, &args.out)?];
+    if !outcome.fits.is_empty() {
+        written.push(write_fits(&outcome, &args.out)?);
+    }
+    for (name, chart) in charts(&outcome) {
+        let path = args.out.join(format!("{}-{name}.svg", outcome.name));
+        plot::write(&chart, &path)?;
+        written.push(path);
+    }
+    print_table(&outcome)?;
+    out!("")?;
+    out!(
+        "ran in {} ({} queries)",
+        human_seconds(seconds),
+        queries(&outcome)
+    )?;
+    for path in written {
+        out!("wrote {}", path.display())?;
+    }
+    Ok(())
+}
+
+fn queries(outcome: &Outcome) -> u64 {
+    outcome.points.iter().map(|p| u64::from(p.queries)).sum()
+}
+
+fn print_table(outcome: &Outcome) -> Result<(), Failure> {
+    let width = |column: fn(&experiment::Comparison) -> &str| {
+        let cells = outcome
+            .comparisons
+            .iter()
+            .map(|c| column(c).chars().count());
+        cells.max().unwrap_or(0)
+    };
+    let (what, reported) = (width(|c| &c.what), width(|c| &c.dissertation).max(12));
+    out!("{}: measured against the dissertation", outcome.name)?;
+    out!("  {:<what$}  {:<reported$}  measured", "", "dissertation")?;
+    for c in &outcome.comparisons {
+        out!(
+            "  {:<what$}  {:<reported$}  {}",
+            c.what,
+            c.dissertation,
+            c.measured
+        )?;
+    }
+    Ok(())
+}
+
+/// The CSV of every point: one row per volume type and parameter value.
+fn write_csv(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
+    let mut text = String::from(
+        "bv,x,queries,contacts,bv_disjoint,bv_overlap,tri_separated,tri_contact,bv_tests,tri_tests,bv_test_lower_bound,seconds\n",
+    );
+    for p in &outcome.points {
+        text.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            p.bv.name(),
+            p.x,
+            p.queries,
+            p.contacts,
+            p.disjoint,
+            p.overlap,
+            p.separated,
+            p.contacts,
+            p.bv_tests(),
+            p.tri_tests(),
+            p.lower_bound,
+            p.seconds
+        ));
+    }
+    let path = dir.join(format!("{}.csv", outcome.name));
+    write_file(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// The fitted lines, one row each: `log10(measure) = slope · log10(x) + intercept` over
+/// `from` to `to`.
+fn write_fits(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
+    let mut text = String::from("bv,measure,slope,intercept,from,to\n");
+    for f in &outcome.fits {
+        text.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            f.bv.name(),
+            f.measure,
+            f.line.slope,
+            f.line.intercept,
+            f.from,
+            f.to
+        ));
+    }
+    let path = dir.join(format!("{}-fits.csv", outcome.name));
+    write_file(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// One series per volume type of `value` against x.
+fn per_kind(outcome: &Outcome, value: impl Fn(&Point) -> Option<f64>) -> Vec<Series> {
+    BvKind::ALL
+        .into_iter()
+        .map(|bv| Series {
+            name: bv.name().to_uppercase(),
+            points: of_kind(&outcome.points, bv)
+                .iter()
+                .filter_map(|p| Some((p.x, value(p)?)))
+                .collect(),
+            line: false,
+        })
+        .collect()
+}
+
+/// The fitted lines of `measure`, as two-point series over their ranges.
+fn fitted(outcome: &Outcome, measure: &str) -> Vec<Series> {
+    outcome
+        .fits
+        .iter()
+        .filter(|f| f.measure == measure)
+        .map(|f| {
+            let at = |x: f64| (x, 10f64.powf(f.line.intercept + f.line.slope * x.log10()));
+            Series {
+                name: format!(
+                    "{} fit, slope {:.2}",
+                    f.bv.name().to_uppercase(),
+                    f.line.slope
+                ),
+                points: vec![at(f.from), at(f.to)],
+                line: true,
+            }
+        })
+        .collect()
+}
+
+fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
+    let chart = |title, x_label, y_label, log_x, log_y, series| Chart {
+        title,
+        x_label,
+        y_label,
+        log_x,
+        log_y,
+        series,
+    };
+    match outcome.name {
+        "sliding" => {
+            let obb = of_kind(&outcome.points, BvKind::Obb);
+            let mut contacts = vec![Series {
+                name: "contacts".into(),
+                points: obb.iter().map(|p| (p.x, p.contacts)).collect(),
+                line: false,
+            }];
+            // The intersection curve's length times the least-squares factor.
+            let (cl, ll) = obb.iter().fold((0.0, 0.0), |(cl, ll), p| {
+                let l = experiment::sliding::intersection_length(p.x);
+                (cl + p.contacts * l, ll + l * l)
+            });
+            if ll > 0.0 {
+                contacts.push(Series {
+                    name: format!("{:.0} x length of the intersection curve", cl / ll),
+                    points: obb
+                        .iter()
+                        .map(|p| (p.x, cl / ll * experiment::sliding::intersection_length(p.x)))
+                        .collect(),
+                    line: true,
+                });
+            }
+            let ratio = |bv| {
+                let series = of_kind(&outcome.points, bv);
+                Series {
+                    name: format!("{} / OBB", bv.name().to_uppercase()),
+                    points: series
+                        .iter()
+                        .zip(&obb)
+                        .filter(|(_, o)| o.bv_tests() > 0.0)
+                        .map(|(s, o)| (s.x, s.bv_tests() / o.bv_tests()))
+                        .collect(),
+                    line: false,
+                }
+            };
+            vec![
+                (
+                    "contacts",
+                    chart(
+                        "Contacts as the small sphere moves (Fig. 5.4)",
+                        "x",
+                        "contacting triangle pairs",
+                        false,
+                        false,
+                        contacts,
+                    ),
+                ),
+                (
+                    "bv-tests",
+                    chart(
+                        "Volume tests (Fig. 5.5)",
+                        "x",
+                        "volume tests",
+                        false,
+                        true,
+                        per_kind(outcome, |p| Some(p.bv_tests())),
+                    ),
+                ),
+                (
+                    "ratios",
+                    chart(
+                        "Volume tests over OBB's (Fig. 5.7)",
+                        "x",
+                        "ratio",
+                        false,
+                        true,
+                        vec![ratio(BvKind::Aabb), ratio(BvKind::Sphere)],
+                    ),
+                ),
+                (
+                    "contact-cost",
+                    chart(
+                        "Contact cost: volume tests per contact (Fig. 5.8)",
+                        "x",
+                        "volume tests per contact",
+                        false,
+                        true,
+                        per_kind(outcome, |p| {
+                            (p.contacts > 0.0).then(|| p.bv_tests() / p.contacts)
+                        }),
+                    ),
+                ),
+            ]
+        }
+        "proximity" => {
+            let mut series = per_kind(outcome, |p| Some(p.bv_tests()));
+            series.extend(fitted(outcome, "bv_tests"));
+            vec![(
+                "bv-tests",
+                chart(
+                    "Parallel close proximity (Fig. 5.11)",
+                    "gap",
+                    "volume tests (mean)",
+                    true,
+                    true,
+                    series,
+                ),
+            )]
+        }
+        _ => {
+            let mut contacts = per_kind(outcome, |p| Some(p.contacts));
+            contacts.extend(fitted(outcome, "contacts"));
+            let mut tests = per_kind(outcome, |p| Some(p.bv_tests()));
+            tests.extend(fitted(outcome, "bv_tests"));
+            vec![
+                (
+                    "contacts",
+                    chart(
+                        "Contacts against tessellation (Fig. 5.21)",
+                        "triangles per sphere",
+                        "contacts (mean)",
+                        true,
+                        true,
+                        contacts,
+                    ),
+                ),
+                (
+                    "bv-tests",
+                    chart(
+                        "Volume tests against tessellation (Fig. 5.22)",
+                        "triangles per sphere",
+                        "volume tests (mean)",
+                        true,
+                        true,
+                        tests,
+                    ),
+                ),
+            ]
+        }
+    }
+}

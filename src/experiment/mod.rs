@@ -1,0 +1,293 @@
+//! The experiments of the dissertation's chapter 5 as functions: each builds its shapes,
+//! runs its collision queries for OBB, AABB and sphere trees, and returns what it measured
+//! with what the dissertation reported beside it. `obbtree experiment` runs them and
+//! writes their CSV files and plots.
+//!
+//! - [`sliding`]: the sliding spheres (§5.3.1);
+//! - [`proximity`]: parallel close proximity (§5.3.2);
+//! - [`transverse`]: transverse contact as the tessellation grows (§5.3.3.1).
+//!
+//! Every query is an all-pairs collision query whose work is counted as the dissertation
+//! counts it: D disjoint and I overlapping volume pairs, S separated and K contacting
+//! triangle pairs (so 1 = D − I + 2S + 2K for binary trees, and the volume tests are
+//! D + I). Queries run on rayon's pool: in a pool of one thread the times are those of a
+//! query alone; with more they are inflated by the work beside them.
+
+pub mod proximity;
+pub mod sliding;
+pub mod transverse;
+
+use crate::build::{build, BuildError, BuildOptions};
+use crate::bv::BvKind;
+use crate::format::ObbtFile;
+use crate::generate::{GenerateError, PosePair, Rng};
+use crate::mesh::TriMesh;
+use crate::query::{collide_files, CollideOptions, Pose, QueryContext, QueryError, Stats};
+use crate::real::Precision;
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// How large an experiment is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Size {
+    /// The dissertation's sizes (meshes, steps and repetitions).
+    Full,
+    /// A reduced size that runs in seconds, with the same shape of results (for tests and
+    /// a first look).
+    Quick,
+}
+
+/// Why an experiment stopped.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExperimentError {
+    /// A shape or pose could not be made.
+    #[error(transparent)]
+    Generate(#[from] GenerateError),
+    /// A tree could not be built.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// A query failed.
+    #[error(transparent)]
+    Query(#[from] QueryError),
+}
+
+/// One measured point: one volume type at one value of the experiment's parameter,
+/// averaged over its queries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// The volume type of both trees.
+    pub bv: BvKind,
+    /// The experiment's parameter (an offset, a gap, a triangle count).
+    pub x: f64,
+    /// Queries averaged.
+    pub queries: u32,
+    /// Mean contacting triangle pairs (K).
+    pub contacts: f64,
+    /// Mean disjoint volume pairs (D).
+    pub disjoint: f64,
+    /// Mean overlapping volume pairs (I).
+    pub overlap: f64,
+    /// Mean separated triangle pairs (S).
+    pub separated: f64,
+    /// Mean of the least number of volume tests that can find each query's contacts
+    /// (§2.6.3: `2 log2(n_a n_b / k) + 2k − 1` for `k > 0` contacts, 0 without contacts).
+    pub lower_bound: f64,
+    /// Median time of one query, seconds.
+    pub seconds: f64,
+}
+
+impl Point {
+    /// Mean volume tests, D + I.
+    pub fn bv_tests(&self) -> f64 {
+        self.disjoint + self.overlap
+    }
+
+    /// Mean triangle tests, S + K.
+    pub fn tri_tests(&self) -> f64 {
+        self.separated + self.contacts
+    }
+
+    /// D − I + 2S + 2K: 1 for every query of a binary tree, so 1 for their mean too.
+    pub fn bvtt_identity(&self) -> f64 {
+        self.disjoint - self.overlap + 2.0 * self.separated + 2.0 * self.contacts
+    }
+}
+
+/// A figure of the dissertation beside the one measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// What is compared.
+    pub what: String,
+    /// The dissertation's figure, as it states it.
+    pub dissertation: String,
+    /// What this run measured.
+    pub measured: String,
+}
+
+impl Comparison {
+    fn new(what: &str, dissertation: &str, measured: String) -> Comparison {
+        Comparison {
+            what: what.into(),
+            dissertation: dissertation.into(),
+            measured,
+        }
+    }
+}
+
+/// What an experiment measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome {
+    /// The experiment's name (`sliding`, `proximity`, `transverse`).
+    pub name: &'static str,
+    /// What the points' `x` is, with its unit.
+    pub x_name: &'static str,
+    /// Every point, volume type by volume type, each in order of x.
+    pub points: Vec<Point>,
+    /// Lines fitted on log-log axes.
+    pub fits: Vec<Fit>,
+    /// The dissertation's figures beside this run's.
+    pub comparisons: Vec<Comparison>,
+}
+
+/// A line fitted to `log10(measure)` against `log10(x)` over part of the points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fit {
+    /// The volume type whose points were fitted.
+    pub bv: BvKind,
+    /// The measure fitted: `"bv_tests"` or `"contacts"`.
+    pub measure: &'static str,
+    /// The fitted line (its slope is the exponent of the power law).
+    pub line: Line,
+    /// The range of x fitted.
+    pub from: f64,
+    /// The range of x fitted.
+    pub to: f64,
+}
+
+/// A straight line `y = slope · x + intercept` fitted by least squares.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Line {
+    /// The slope.
+    pub slope: f64,
+    /// The value at x = 0.
+    pub intercept: f64,
+}
+
+/// The least-squares line through `points`; `None` for fewer than two distinct x.
+pub fn fit_line(points: &[(f64, f64)]) -> Option<Line> {
+    let n = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(sx, sy), (x, y)| (sx + x, sy + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxx, sxy) = points.iter().fold((0.0, 0.0), |(sxx, sxy), (x, y)| {
+        (sxx + (x - mx) * (x - mx), sxy + (x - mx) * (y - my))
+    });
+    (points.len() >= 2 && sxx > 0.0).then(|| {
+        let slope = sxy / sxx;
+        Line {
+            slope,
+            intercept: my - slope * mx,
+        }
+    })
+}
+
+/// The trees of the experiments: default builds (hull fit, OBB frames also tried on the
+/// model's axes) in f64, as the dissertation's were in double precision.
+fn tree(mesh: &TriMesh, bv: BvKind) -> Result<ObbtFile, BuildError> {
+    let options = BuildOptions {
+        bv,
+        precision: Precision::F64,
+        ..BuildOptions::default()
+    };
+    build(mesh, &options, None)
+}
+
+/// Both models turned at random (uniformly, drawn from `rng`) and B's centre at
+/// `offset`: "the two spheres are given random orientation".
+fn turned_pair(rng: &mut Rng, offset: Vector3<f64>) -> PosePair {
+    let a = Pose::new(rng.uniform_rotation(), Vector3::zeros()).unwrap_or_default();
+    let b = Pose::new(rng.uniform_rotation(), offset).unwrap_or_default();
+    [a, b]
+}
+
+/// A point's queries: the trees and, for each query, its pose pair.
+struct Job<'t> {
+    a: &'t ObbtFile,
+    b: &'t ObbtFile,
+    bv: BvKind,
+    x: f64,
+    poses: Vec<PosePair>,
+}
+
+/// Runs every job's queries (in parallel over all queries of all jobs) and averages each
+/// job's into a [`Point`].
+fn measure(jobs: &[Job<'_>]) -> Result<Vec<Point>, ExperimentError> {
+    let queries: Vec<(usize, &Job<'_>, &PosePair)> = jobs
+        .iter()
+        .enumerate()
+        .flat_map(|(j, job)| job.poses.iter().map(move |p| (j, job, p)))
+        .collect();
+    let results: Vec<Result<(usize, Stats, usize, f64), QueryError>> = queries
+        .par_iter()
+        .map_init(QueryContext::new, |context, &(j, job, [pa, pb])| {
+            let started = Instant::now();
+            let r = collide_files(job.a, pa, job.b, pb, &CollideOptions::default(), context)?;
+            Ok((j, r.stats, r.pairs.len(), started.elapsed().as_secs_f64()))
+        })
+        .collect();
+    let mut sums = vec![(Stats::default(), 0.0f64, Vec::new()); jobs.len()];
+    let cells: Vec<f64> = jobs
+        .iter()
+        .map(|job| f64::from(job.a.info().triangles) * f64::from(job.b.info().triangles))
+        .collect();
+    for result in results {
+        let (j, stats, contacts, seconds) = result?;
+        let (Some((sum, bound, times)), Some(&cells)) = (sums.get_mut(j), cells.get(j)) else {
+            continue;
+        };
+        sum.bv_disjoint += stats.bv_disjoint;
+        sum.bv_overlap += stats.bv_overlap;
+        sum.tri_separated += stats.tri_separated;
+        sum.tri_contact += stats.tri_contact;
+        *bound += lower_bound(cells, contacts);
+        times.push(seconds);
+    }
+    Ok(jobs
+        .iter()
+        .zip(sums)
+        .map(|(job, (sum, bound, mut times))| {
+            let n = job.poses.len().max(1) as f64;
+            times.sort_by(f64::total_cmp);
+            Point {
+                bv: job.bv,
+                x: job.x,
+                queries: job.poses.len() as u32,
+                contacts: sum.tri_contact as f64 / n,
+                disjoint: sum.bv_disjoint as f64 / n,
+                overlap: sum.bv_overlap as f64 / n,
+                separated: sum.tri_separated as f64 / n,
+                lower_bound: bound / n,
+                seconds: times.get(times.len() / 2).copied().unwrap_or(0.0),
+            }
+        })
+        .collect())
+}
+
+/// The least number of volume tests that can locate `contacts` contacts among `cells`
+/// triangle pairs (§2.6.3), 0 without contacts.
+pub fn lower_bound(cells: f64, contacts: usize) -> f64 {
+    if contacts == 0 {
+        return 0.0;
+    }
+    let k = contacts as f64;
+    2.0 * (cells / k).log2() + 2.0 * k - 1.0
+}
+
+/// The points of one volume type, in order of x.
+pub fn of_kind(points: &[Point], bv: BvKind) -> Vec<Point> {
+    points.iter().filter(|p| p.bv == bv).copied().collect()
+}
+
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fitted_line_recovers_slope_and_intercept() {
+        let points: Vec<(f64, f64)> = (0..10)
+            .map(|i| (f64::from(i), 3.0 - 1.5 * f64::from(i)))
+            .collect();
+        let line = fit_line(&points).unwrap();
+        assert!((line.slope + 1.5).abs() < 1e-12 && (line.intercept - 3.0).abs() < 1e-12);
+        assert!(fit_line(&[(1.0, 2.0)]).is_none());
+        assert!(fit_line(&[(1.0, 2.0), (1.0, 3.0)]).is_none());
+    }
+}
