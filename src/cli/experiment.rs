@@ -185,13 +185,15 @@ fn write_fits(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
 fn per_kind(outcome: &Outcome, value: impl Fn(&Point) -> Option<f64>) -> Vec<Series> {
     BvKind::ALL
         .into_iter()
-        .map(|bv| Series {
+        .enumerate()
+        .map(|(colour, bv)| Series {
             name: bv.name().to_uppercase(),
             points: of_kind(&outcome.points, bv)
                 .iter()
                 .filter_map(|p| Some((p.x, value(p)?)))
                 .collect(),
             line: false,
+            colour,
         })
         .collect()
 }
@@ -212,9 +214,52 @@ fn fitted(outcome: &Outcome, measure: &str) -> Vec<Series> {
                 ),
                 points: vec![at(f.from), at(f.to)],
                 line: true,
+                colour: BvKind::ALL.iter().position(|&k| k == f.bv).unwrap_or(0),
             }
         })
         .collect()
+}
+
+/// Mean thickness per level for each volume type, and the dissertation's reference for
+/// OBBs: a quarter every two levels, from level 2 to the last full level.
+fn thickness(outcome: &Outcome) -> Vec<Series> {
+    let mut series: Vec<Series> = outcome
+        .levels
+        .iter()
+        .map(|(bv, levels)| Series {
+            name: bv.name().to_uppercase(),
+            // Levels of flat single-triangle leaves (thickness at rounding level) left out.
+            points: levels
+                .iter()
+                .enumerate()
+                .map(|(l, s)| (l as f64, s.thickness.0))
+                .filter(|&(_, t)| {
+                    levels
+                        .first()
+                        .is_some_and(|root| t > 1e-6 * root.thickness.0)
+                })
+                .collect(),
+            line: false,
+            colour: BvKind::ALL.iter().position(|k| k == bv).unwrap_or(0),
+        })
+        .collect();
+    let obb = outcome.levels.iter().find(|(bv, _)| *bv == BvKind::Obb);
+    if let Some((_, levels)) = obb {
+        let (Some(top), Some(last)) = (
+            levels.get(2),
+            experiment::proximity::last_full_level(levels),
+        ) else {
+            return series;
+        };
+        let at = |l: f64| (l, top.thickness.0 * 4f64.powf(-(l - 2.0) / 2.0));
+        series.push(Series {
+            name: "a quarter every two levels".into(),
+            points: vec![at(2.0), at(last as f64)],
+            line: true,
+            colour: 5,
+        });
+    }
+    series
 }
 
 fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
@@ -233,6 +278,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                 name: "contacts".into(),
                 points: obb.iter().map(|p| (p.x, p.contacts)).collect(),
                 line: false,
+                colour: 0,
             }];
             // The intersection curve's length times the least-squares factor.
             let (cl, ll) = obb.iter().fold((0.0, 0.0), |(cl, ll), p| {
@@ -247,11 +293,13 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                         .map(|p| (p.x, cl / ll * experiment::sliding::intersection_length(p.x)))
                         .collect(),
                     line: true,
+                    colour: 3,
                 });
             }
-            let ratio = |bv| {
+            let ratio = |bv, colour| {
                 let series = of_kind(&outcome.points, bv);
                 Series {
+                    colour,
                     name: format!("{} / OBB", bv.name().to_uppercase()),
                     points: series
                         .iter()
@@ -293,7 +341,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                         "ratio",
                         false,
                         true,
-                        vec![ratio(BvKind::Aabb), ratio(BvKind::Sphere)],
+                        vec![ratio(BvKind::Aabb, 1), ratio(BvKind::Sphere, 2)],
                     ),
                 ),
                 (
@@ -314,17 +362,30 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
         "proximity" => {
             let mut series = per_kind(outcome, |p| Some(p.bv_tests()));
             series.extend(fitted(outcome, "bv_tests"));
-            vec![(
-                "bv-tests",
-                chart(
-                    "Parallel close proximity (Fig. 5.11)",
-                    "gap",
-                    "volume tests (mean)",
-                    true,
-                    true,
-                    series,
+            vec![
+                (
+                    "bv-tests",
+                    chart(
+                        "Parallel close proximity (Fig. 5.11)",
+                        "gap",
+                        "volume tests (mean)",
+                        true,
+                        true,
+                        series,
+                    ),
                 ),
-            )]
+                (
+                    "thickness",
+                    chart(
+                        "Mean thickness per level, inner sphere (Fig. 5.17)",
+                        "level",
+                        "mean thickness",
+                        false,
+                        true,
+                        thickness(outcome),
+                    ),
+                ),
+            ]
         }
         _ => {
             let mut contacts = per_kind(outcome, |p| Some(p.contacts));

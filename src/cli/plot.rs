@@ -13,6 +13,9 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Drawn as a line through the points (otherwise as dots).
     pub line: bool,
+    /// Index of its colour in the palette: a volume type's points and fitted line share
+    /// one.
+    pub colour: usize,
 }
 
 /// A chart to draw.
@@ -25,7 +28,7 @@ pub struct Chart<'a> {
     pub series: Vec<Series>,
 }
 
-/// The series' colours, one per volume type in `BvKind::ALL` order, then the rest.
+/// The series' colours: one per volume type in `BvKind::ALL` order, then the rest.
 const COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -89,15 +92,7 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             .y_label_area_size(70)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(|e| fail(&e))?;
-        let tick = |log: bool| {
-            move |v: &f64| {
-                if log {
-                    format!("1e{}", (*v * 100.0).round() / 100.0)
-                } else {
-                    format!("{}", (*v * 1000.0).round() / 1000.0)
-                }
-            }
-        };
+        let tick = |log: bool| move |v: &f64| tick_label(if log { 10f64.powf(*v) } else { *v });
         let (fx, fy) = (tick(chart.log_x), tick(chart.log_y));
         c.configure_mesh()
             .x_desc(chart.x_label)
@@ -107,8 +102,11 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(|e| fail(&e))?;
-        for (k, (s, points)) in series.iter().enumerate() {
-            let colour = COLOURS.get(k % COLOURS.len()).copied().unwrap_or(BLACK);
+        for (s, points) in &series {
+            let colour = COLOURS
+                .get(s.colour % COLOURS.len())
+                .copied()
+                .unwrap_or(BLACK);
             let legend = move |(x, y): (i32, i32)| {
                 PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2))
             };
@@ -132,13 +130,120 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             }
         }
         c.configure_series_labels()
+            .position(emptiest_corner(&series, (x0, x1), (y0, y1)))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
             .map_err(|e| fail(&e))?;
         root.present().map_err(|e| fail(&e))?;
     }
-    Ok(text)
+    Ok(compact_markers(&text))
+}
+
+/// Where the legend covers the fewest points: the corner (a third of the width, 40% of
+/// the height) holding the fewest, the upper right on ties.
+fn emptiest_corner(
+    series: &[(&Series, Vec<(f64, f64)>)],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> SeriesLabelPosition {
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let inside = |(x, y): (f64, f64), right: bool, upper: bool| {
+        let (u, v) = ((x - x0) / (x1 - x0), (y - y0) / (y1 - y0));
+        (if right { u > 2.0 / 3.0 } else { u < 1.0 / 3.0 })
+            && (if upper { v > 0.6 } else { v < 0.4 })
+    };
+    let covered = |right: bool, upper: bool| {
+        let points = series.iter().flat_map(|(_, p)| p.iter());
+        points.filter(|&&p| inside(p, right, upper)).count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|&(_, right, upper)| covered(right, upper))
+        .map_or(SeriesLabelPosition::UpperRight, |(corner, _, _)| corner)
+}
+
+/// A tick's value with at most three significant digits, in scientific notation beyond
+/// 1e4 and below 1e-3.
+fn tick_label(v: f64) -> String {
+    let magnitude = v.abs();
+    if v == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e4).contains(&magnitude) {
+        let text = format!("{v:.2e}");
+        // 1.00e5 -> 1e5, 3.20e4 -> 3.2e4.
+        match text.split_once('e') {
+            Some((mantissa, exponent)) => {
+                let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+                format!("{mantissa}e{exponent}")
+            }
+            None => text,
+        }
+    } else {
+        let digits = (2 - magnitude.log10().floor() as i32).clamp(0, 6) as usize;
+        let text = format!("{v:.digits$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    }
+}
+
+/// plotters writes one `<circle>` element per dot (about 90 bytes); runs of dots of one
+/// style become one path of zero-length round-capped segments (about 10 bytes a dot), so
+/// a chart of 3,000 dots stays small enough to commit.
+fn compact_markers(svg: &str) -> String {
+    let mut out = String::with_capacity(svg.len() / 4);
+    // The style of the current run and its path data.
+    let mut run: Option<(String, String, String)> = None;
+    let flush = |out: &mut String, run: &mut Option<(String, String, String)>| {
+        if let Some((fill, opacity, d)) = run.take() {
+            out.push_str(&format!(
+                "<path d=\"{d}\" stroke=\"{fill}\" stroke-opacity=\"{opacity}\" stroke-width=\"4\" stroke-linecap=\"round\" fill=\"none\"/>\n"
+            ));
+        }
+    };
+    for line in svg.lines() {
+        let attribute = |name: &str| {
+            let start = line.find(&format!(" {name}=\""))? + name.len() + 3;
+            let rest = line.get(start..)?;
+            rest.get(..rest.find('"')?)
+        };
+        let circle = line.starts_with("<circle ") && attribute("r") == Some("2");
+        match (
+            circle,
+            attribute("cx"),
+            attribute("cy"),
+            attribute("fill"),
+            attribute("opacity"),
+        ) {
+            (true, Some(x), Some(y), Some(fill), Some(opacity)) => {
+                let same = run
+                    .as_ref()
+                    .is_some_and(|(f, o, _)| f == fill && o == opacity);
+                if !same {
+                    flush(&mut out, &mut run);
+                    run = Some((fill.into(), opacity.into(), String::new()));
+                }
+                if let Some((_, _, d)) = run.as_mut() {
+                    d.push_str(&format!("M{x} {y}h0"));
+                }
+            }
+            _ => {
+                flush(&mut out, &mut run);
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    flush(&mut out, &mut run);
+    out
 }
 
 /// Draws `chart` to `path` (atomically).

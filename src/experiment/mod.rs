@@ -24,6 +24,7 @@ use crate::generate::{GenerateError, PosePair, Rng};
 use crate::mesh::TriMesh;
 use crate::query::{collide_files, CollideOptions, Pose, QueryContext, QueryError, Stats};
 use crate::real::Precision;
+use crate::stats::LevelStats;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -51,6 +52,9 @@ pub enum ExperimentError {
     /// A query failed.
     #[error(transparent)]
     Query(#[from] QueryError),
+    /// A tree's levels could not be measured (a bug: the experiments' trees are sound).
+    #[error("measuring a tree's levels: {0}")]
+    Levels(crate::format::VerifyError),
 }
 
 /// One measured point: one volume type at one value of the experiment's parameter,
@@ -129,6 +133,9 @@ pub struct Outcome {
     pub fits: Vec<Fit>,
     /// The dissertation's figures beside this run's.
     pub comparisons: Vec<Comparison>,
+    /// The volumes of one tree per volume type measured level by level, where the
+    /// experiment looks at them (Fig. 5.17); empty otherwise.
+    pub levels: Vec<(BvKind, Vec<LevelStats>)>,
 }
 
 /// A line fitted to `log10(measure)` against `log10(x)` over part of the points.

@@ -11,6 +11,7 @@ use super::{
 };
 use crate::bv::BvKind;
 use crate::generate::{lat_long_sphere, Rng};
+use crate::stats::LevelStats;
 use nalgebra::Vector3;
 
 /// Runs the experiment: 40,000-triangle spheres, gaps 100 to 1e-7 in quarter decades and
@@ -38,8 +39,10 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
         .map(|_| turned_pair(&mut rng, Vector3::zeros()))
         .collect();
     let mut points = Vec::new();
+    let mut levels = Vec::new();
     for bv in BvKind::ALL {
         let b = super::tree(&inner, bv)?;
+        levels.push((bv, b.level_stats().map_err(ExperimentError::Levels)?));
         let trees = outers
             .iter()
             .map(|outer| super::tree(outer, bv))
@@ -64,13 +67,15 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
         .into_iter()
         .filter_map(|bv| ramp_fit(&of_kind(&points, bv), bv))
         .collect();
-    let comparisons = compare(&points, &fits);
+    let mut comparisons = compare(&points, &fits);
+    comparisons.extend(thinning(&levels));
     Ok(Outcome {
         name: "proximity",
         x_name: "gap between the spheres",
         points,
         fits,
         comparisons,
+        levels,
     })
 }
 
@@ -111,6 +116,52 @@ pub fn ramp_fit(points: &[Point], bv: BvKind) -> Option<Fit> {
         from,
         to,
     })
+}
+
+/// The deepest level whose nodes are all internal (level `l` of a binary tree holds
+/// `2^l` nodes until leaves appear): below it, single-triangle leaves of no thickness
+/// skew the mean, as the dissertation notes of Fig. 5.17.
+pub fn last_full_level(levels: &[LevelStats]) -> Option<usize> {
+    let full = |(l, s): &(usize, &LevelStats)| {
+        u32::try_from(*l).ok().and_then(|l| 2u64.checked_pow(l)) == Some(s.nodes)
+    };
+    let last = levels.iter().enumerate().take_while(full).last()?.0;
+    // The last full level's nodes may have leaves as children.
+    last.checked_sub(1)
+}
+
+/// How much the inner sphere's mean volume thickness shrinks over two levels, as a
+/// geometric mean from level 2 to [`last_full_level`] (Fig. 5.17: OBBs 4x, the rate
+/// that gives slope −1; AABBs and spheres shrink only as their diameter does, 2x).
+fn thinning(levels: &[(BvKind, Vec<LevelStats>)]) -> Vec<Comparison> {
+    levels
+        .iter()
+        .map(|(bv, stats)| {
+            let thickness = |l: usize| stats.get(l).map(|s| s.thickness.0);
+            let last = last_full_level(stats).filter(|&l| l > 2);
+            let measured = match (thickness(2), last.and_then(thickness), last) {
+                (Some(top), Some(bottom), Some(last)) if bottom > 0.0 => {
+                    format!(
+                        "{:.2} (levels 2 to {last})",
+                        (top / bottom).powf(2.0 / (last as f64 - 2.0))
+                    )
+                }
+                _ => "-".into(),
+            };
+            Comparison::new(
+                &format!(
+                    "{} mean thickness shrink per two levels",
+                    bv.name().to_uppercase()
+                ),
+                if *bv == BvKind::Obb {
+                    "4"
+                } else {
+                    "2 (as the diameter)"
+                },
+                measured,
+            )
+        })
+        .collect()
 }
 
 fn compare(points: &[Point], fits: &[Fit]) -> Vec<Comparison> {

@@ -51,6 +51,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
         points,
         fits: Vec::new(),
         comparisons,
+        levels: Vec::new(),
     })
 }
 

@@ -88,6 +88,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
         points,
         fits,
         comparisons,
+        levels: Vec::new(),
     })
 }
 
