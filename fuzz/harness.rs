@@ -15,7 +15,7 @@
 mod seal;
 
 use obbtree::build::{
-    build, BuildError, BuildOptions, DEFAULT_HULL_MAX_POINTS, DEFAULT_HULL_MIN_FACES,
+    build, BuildError, BuildOptions, SphereFit, DEFAULT_HULL_MAX_POINTS, DEFAULT_HULL_MIN_FACES,
 };
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
@@ -98,6 +98,7 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         // Small enough that fuzzed meshes get sampled hulls too.
         hull_max_points: [4, DEFAULT_HULL_MAX_POINTS][(pick / 864) % 2],
         model_axes: (pick / 1728) % 2 == 0,
+        sphere_fit: [SphereFit::BoxCentre, SphereFit::Minimal][(pick / 3456) % 2],
     };
     // Fuzzed meshes are small: with the default threshold the hull fit would never run.
     let hull_everywhere = BuildOptions {

@@ -199,6 +199,19 @@ proptest! {
     }
 
     #[test]
+    fn the_rewrapped_test_is_looser_and_still_never_misses_an_overlap(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
+        // Every pair the 15 axes pass, the re-wrapped box passes too (it tests 3 of them),
+        // and overlapping boxes pass both.
+        if a.overlaps(&b, &b_to_a, SAT_GUARD) {
+            prop_assert!(a.overlaps_rewrapped(&b, &b_to_a, SAT_GUARD));
+        }
+        let inside = grid_points(&b, 5).iter().any(|q| a.contains(b_to_a.apply(q).into(), 1e-12));
+        if inside {
+            prop_assert!(a.overlaps_rewrapped(&b, &b_to_a, SAT_GUARD));
+        }
+    }
+
+    #[test]
     fn enclosing_balls_hold_every_corner(b in arb_box(), far in prop::array::uniform3(-1e6..1e6f64), lo in prop::array::uniform3(-2.0..2.0f64), side in prop::array::uniform3(0.0..1e-3f64)) {
         // The ball test that culls collision queries at the roots must never cut a corner
         // off: f64 boxes, the same boxes rounded to f32 (frames then off orthonormal by

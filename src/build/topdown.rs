@@ -5,7 +5,7 @@
 //! a task are split in parallel, and the subtrees are then laid out in the order a serial
 //! build gives, so the output never depends on scheduling.
 
-use super::BuildOptions;
+use super::{BuildOptions, SphereFit};
 use crate::arr3::dot;
 use crate::bv::BoundingVolume;
 use crate::fit::{principal_axes, principal_axes_and_vertices, FaceMoment, FaceMoments, FitMethod};
@@ -200,7 +200,7 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
             || {
                 input_faces
                     .par_iter()
-                    .map(|f| leaf_volume::<B>(options.fit_for(1), positions, f))
+                    .map(|f| leaf_volume::<B>(options, positions, f))
                     .collect::<Vec<B>>()
             },
         );
@@ -227,9 +227,30 @@ pub(crate) fn build_drafts<B: BoundingVolume>(
 
 /// The volume of a leaf holding just `face`: exactly what the builder computes for such
 /// a node.
-fn leaf_volume<B: BoundingVolume>(fit: FitMethod, positions: &[[f64; 3]], face: &[u32; 3]) -> B {
-    let axes = principal_axes(fit, positions, std::slice::from_ref(face));
+fn leaf_volume<B: BoundingVolume>(
+    options: &BuildOptions,
+    positions: &[[f64; 3]],
+    face: &[u32; 3],
+) -> B {
+    if let Some(ball) = minimal_ball::<B>(options, positions, face) {
+        return ball;
+    }
+    let axes = principal_axes(options.fit_for(1), positions, std::slice::from_ref(face));
     B::enclose_vertices(&axes, positions, face)
+}
+
+/// The minimal-ball sphere of `vertices` when the build asks for one (sphere trees with
+/// [`SphereFit::Minimal`]).
+fn minimal_ball<B: BoundingVolume>(
+    options: &BuildOptions,
+    positions: &[[f64; 3]],
+    vertices: &[u32],
+) -> Option<B> {
+    if options.sphere_fit == SphereFit::Minimal {
+        B::enclose_vertices_minimal_ball(positions, vertices)
+    } else {
+        None
+    }
 }
 
 /// Buffers reused from node to node by one task.
@@ -288,6 +309,7 @@ fn fit_and_split<B: BoundingVolume>(
             B::enclose_vertices(&axes, ctx.positions, &scratch.vertices),
         )
     };
+    let bv = minimal_ball(ctx.options, ctx.positions, &scratch.vertices).unwrap_or(bv);
     if faces.len() <= ctx.options.leaf_size as usize {
         if let Some(p) = ctx.progress {
             p.fetch_add(faces.len() as u64, Ordering::Relaxed);

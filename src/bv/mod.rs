@@ -6,6 +6,7 @@
 //! trees of different volume types over the same mesh have the same shape.
 
 mod aabb;
+mod ball;
 mod obb;
 pub mod pair;
 mod sphere;
@@ -169,6 +170,13 @@ pub trait BoundingVolume:
         ]
     }
 
+    /// For sphere volumes, the sphere about the centre of the smallest ball containing
+    /// `vertices` (`--sphere-fit minimal`: the dissertation compared boxes with such
+    /// spheres); `None` for the other types.
+    fn enclose_vertices_minimal_ball(_positions: &[[f64; 3]], _vertices: &[u32]) -> Option<Self> {
+        None
+    }
+
     /// Writes the little-endian bytes of this volume in on-disk field order into the first
     /// `size_of::<Self>()` bytes of `out` (fewer if `out` is shorter).
     fn write_le(&self, out: &mut [u8]);
@@ -184,6 +192,16 @@ pub trait BoundingVolume:
     /// Conservative: `false` only if they are certainly disjoint. `guard` is the
     /// separating-axis guard of §4.5 ([`pair::SAT_GUARD`]; boxes only).
     fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool;
+
+    /// [`BoundingVolume::overlaps`] as the dissertation's experiments tested boxes of
+    /// simpler types: `other` re-wrapped in the smallest box aligned with this volume's
+    /// frame, and the two compared on this volume's three axes only
+    /// ([`pair::BoxPair::rewrapped_disjoint`]). Looser (more pairs pass) and cheaper; the
+    /// same as `overlaps` for spheres.
+    #[inline]
+    fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+        self.overlaps(other, b_to_a, guard)
+    }
 
     /// A lower bound on the distance between this volume and `other` (posed as in
     /// [`BoundingVolume::overlaps`]); 0 when they may overlap. The tightest this volume

@@ -126,12 +126,8 @@ impl BoxPair {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
         let abs = m.abs().add_scalar(guard);
         let slack = self.slack(guard);
-        // A's face axes.
-        for i in 0..3 {
-            let rb = b[0] * abs[(i, 0)] + b[1] * abs[(i, 1)] + b[2] * abs[(i, 2)];
-            if t[i].abs() > a[i] + rb + slack {
-                return true;
-            }
+        if self.separated_on_a_faces(&abs, slack) {
+            return true;
         }
         // B's face axes.
         for j in 0..3 {
@@ -152,6 +148,32 @@ impl BoxPair {
                 if tl.abs() > ra + rb + slack {
                     return true;
                 }
+            }
+        }
+        false
+    }
+
+    /// Whether the boxes are disjoint by A's three face axes alone: B's box re-wrapped in
+    /// the axis-aligned box of A's box frame that contains it, tested against A. This is
+    /// the AABB test as the dissertation's experiments ran it (§5.2.2): cheaper than
+    /// [`BoxPair::disjoint`], and it reports fewer disjoint pairs. Conservative, with the
+    /// same guard and slack.
+    #[inline(always)]
+    pub fn rewrapped_disjoint(&self, guard: f64) -> bool {
+        let abs = self.m.abs().add_scalar(guard);
+        self.separated_on_a_faces(&abs, self.slack(guard))
+    }
+
+    /// The first three separating axes: A's faces, with `abs` the guarded `|m|`.
+    #[inline(always)]
+    // why: as in `disjoint`, axis numbers in 0..3.
+    #[allow(clippy::indexing_slicing)]
+    fn separated_on_a_faces(&self, abs: &Matrix3<f64>, slack: f64) -> bool {
+        let (t, a, b) = (&self.t, &self.ha, &self.hb);
+        for i in 0..3 {
+            let rb = b[0] * abs[(i, 0)] + b[1] * abs[(i, 1)] + b[2] * abs[(i, 2)];
+            if t[i].abs() > a[i] + rb + slack {
+                return true;
             }
         }
         false
@@ -345,6 +367,13 @@ macro_rules! box_pair_methods {
             !self
                 .pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Fast)
                 .disjoint(guard)
+        }
+
+        #[inline]
+        fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+            !self
+                .pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Fast)
+                .rewrapped_disjoint(guard)
         }
 
         #[inline]

@@ -59,7 +59,13 @@ impl<R: Real> Sphere<R> {
                 .map(|(x, (lo, hi))| x * 0.5 * (lo + hi))
                 .sum()
         });
-        let center = c.map(R::from_f64_nearest);
+        Self::around(c, points)
+    }
+
+    /// The sphere of `points` about `center` (rounded to the stored precision), its radius
+    /// the largest distance rounded outward.
+    fn around<'a>(center: [f64; 3], points: impl Iterator<Item = &'a [f64; 3]>) -> Self {
+        let center = center.map(R::from_f64_nearest);
         let c = point_to_f64(&center);
         let mut r2 = 0.0f64;
         let mut l1_max = 0.0f64;
@@ -89,6 +95,13 @@ impl<R: Real> BoundingVolume for Sphere<R> {
 
     fn enclose_vertices(frame: &Matrix3<f64>, positions: &[[f64; 3]], vertices: &[u32]) -> Self {
         Self::enclose_points(frame, listed_vertices(positions, vertices))
+    }
+
+    /// Centred on the smallest ball's centre ([`super::ball`]); the radius measured from it.
+    fn enclose_vertices_minimal_ball(positions: &[[f64; 3]], vertices: &[u32]) -> Option<Self> {
+        let points = listed_vertices(positions, vertices);
+        let center = super::ball::minimal_ball_center(points.clone());
+        Some(Self::around(center, points))
     }
 
     fn write_le(&self, out: &mut [u8]) {

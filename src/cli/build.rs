@@ -4,7 +4,7 @@ use super::files::check_output;
 use super::{human_bytes, Failure};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use obbtree::build::{build, BuildOptions};
+use obbtree::build::{build, BuildOptions, SphereFit};
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
 use obbtree::format::{remove_stale_temporaries, ObbtFile};
@@ -95,6 +95,11 @@ pub struct TreeArgs {
     /// smaller: parts modelled along their axes (CAD) get much tighter boxes [default: yes].
     #[arg(long, value_name = "yes|no", value_parser = parse_yes_no)]
     pub model_axes: Option<bool>,
+    /// With --bv sphere, where each sphere is centred: on its node's box centre, or on
+    /// the centre of the smallest ball of its vertices (tighter, slower to build; the
+    /// spheres the dissertation's comparisons used) [default: box-centre].
+    #[arg(long, value_enum)]
+    pub sphere_fit: Option<SphereFitArg>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
     /// [default: 1].
     #[arg(long, value_name = "N")]
@@ -142,6 +147,15 @@ pub enum FitArg {
     Vertices,
 }
 
+/// `--sphere-fit` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum SphereFitArg {
+    /// The centre of the node's box along its fitted frame.
+    BoxCentre,
+    /// The centre of the smallest ball containing the node's vertices.
+    Minimal,
+}
+
 /// `--precision` values.
 #[derive(ValueEnum, Clone, Copy, Debug)]
 pub enum PrecisionArg {
@@ -174,6 +188,10 @@ impl TreeArgs {
             hull_max_points: self.hull_max_points.unwrap_or(default.hull_max_points),
             leaf_size: self.leaf_size.unwrap_or(default.leaf_size),
             model_axes: self.model_axes.unwrap_or(default.model_axes),
+            sphere_fit: self.sphere_fit.map_or(default.sphere_fit, |f| match f {
+                SphereFitArg::BoxCentre => SphereFit::BoxCentre,
+                SphereFitArg::Minimal => SphereFit::Minimal,
+            }),
             ..default
         }
     }
@@ -185,6 +203,8 @@ impl TreeArgs {
             ("--fit", self.fit.is_some()),
             ("--hull-min-faces", self.hull_min_faces.is_some()),
             ("--hull-max-points", self.hull_max_points.is_some()),
+            ("--model-axes", self.model_axes.is_some()),
+            ("--sphere-fit", self.sphere_fit.is_some()),
             ("--leaf-size", self.leaf_size.is_some()),
             ("--precision", self.precision.is_some()),
         ]

@@ -7,7 +7,7 @@ use super::print::out;
 use super::{human_seconds, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::bv::BvKind;
-use obbtree::experiment::{self, of_kind, Outcome, Point, Size};
+use obbtree::experiment::{self, of_kind, of_variant, Outcome, Point, Size, Variant};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -137,12 +137,12 @@ fn print_table(outcome: &Outcome) -> Result<(), Failure> {
 /// The CSV of every point: one row per volume type and parameter value.
 fn write_csv(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
     let mut text = String::from(
-        "bv,x,queries,contacts,bv_disjoint,bv_overlap,tri_separated,tri_contact,bv_tests,tri_tests,bv_test_lower_bound,seconds\n",
+        "volume,x,queries,contacts,bv_disjoint,bv_overlap,tri_separated,tri_contact,bv_tests,tri_tests,bv_test_lower_bound,seconds\n",
     );
     for p in &outcome.points {
         text.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            p.bv.name(),
+            p.label(),
             p.x,
             p.queries,
             p.contacts,
@@ -296,11 +296,12 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     colour: 3,
                 });
             }
-            let ratio = |bv, colour| {
-                let series = of_kind(&outcome.points, bv);
+            let ratio = |bv, variant, colour| {
+                let series = of_variant(&outcome.points, bv, variant);
+                let name = series.first().map_or(String::new(), Point::label);
                 Series {
                     colour,
-                    name: format!("{} / OBB", bv.name().to_uppercase()),
+                    name: format!("{} / obb", name),
                     points: series
                         .iter()
                         .zip(&obb)
@@ -341,7 +342,12 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                         "ratio",
                         false,
                         true,
-                        vec![ratio(BvKind::Aabb, 1), ratio(BvKind::Sphere, 2)],
+                        vec![
+                            ratio(BvKind::Aabb, Variant::Standard, 1),
+                            ratio(BvKind::Sphere, Variant::Standard, 2),
+                            ratio(BvKind::Aabb, Variant::Rewrapped, 3),
+                            ratio(BvKind::Sphere, Variant::MinimalSpheres, 4),
+                        ],
                     ),
                 ),
                 (

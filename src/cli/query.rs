@@ -9,8 +9,8 @@ use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, Pose, QueryContext, Stats,
+    collide_files, distance_files, span_files, within_tolerance_files, BoxTest, CollideOptions,
+    DescentRule, DistanceOptions, Pose, QueryContext, Stats,
 };
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -85,6 +85,16 @@ impl RuleArg {
     }
 }
 
+/// `--box-test` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum BoxTestArg {
+    /// The 15 separating axes (exact up to the guard).
+    Sat,
+    /// B's box re-wrapped in a box aligned with A's and tested on A's axes: the AABB test
+    /// of the dissertation's experiments (looser and cheaper).
+    Rewrapped,
+}
+
 /// Find the triangle pairs where two posed models touch.
 ///
 /// Models are surfaces: they collide when some triangle of A shares a point with some
@@ -99,6 +109,9 @@ pub struct CollideArgs {
     /// List the contacting pairs (input-mesh triangle ids).
     #[arg(long)]
     pub pairs: bool,
+    /// How box pairs are tested (for experiments; the answer is the same, the work not).
+    #[arg(long, value_enum, default_value_t = BoxTestArg::Sat)]
+    pub box_test: BoxTestArg,
     #[command(flatten)]
     pub inputs: QueryInputs,
 }
@@ -379,6 +392,10 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
     let options = CollideOptions {
         first_contact: args.first,
         rule: args.inputs.rule.rule(),
+        box_test: match args.box_test {
+            BoxTestArg::Sat => BoxTest::SeparatingAxes,
+            BoxTestArg::Rewrapped => BoxTest::Rewrapped,
+        },
         ..CollideOptions::default()
     };
     let cells = f64::from(a.info().triangles) * f64::from(b.info().triangles);

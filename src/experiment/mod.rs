@@ -17,12 +17,12 @@ pub mod proximity;
 pub mod sliding;
 pub mod transverse;
 
-use crate::build::{build, BuildError, BuildOptions};
+use crate::build::{build, BuildError, BuildOptions, SphereFit};
 use crate::bv::BvKind;
 use crate::format::ObbtFile;
 use crate::generate::{GenerateError, PosePair, Rng};
 use crate::mesh::TriMesh;
-use crate::query::{collide_files, CollideOptions, Pose, QueryContext, QueryError, Stats};
+use crate::query::{collide_files, BoxTest, CollideOptions, Pose, QueryContext, QueryError, Stats};
 use crate::real::Precision;
 use crate::stats::LevelStats;
 use nalgebra::Vector3;
@@ -57,12 +57,28 @@ pub enum ExperimentError {
     Levels(crate::format::VerifyError),
 }
 
+/// How the trees are built and their volumes tested, beyond the volume type: today's
+/// defaults, or how the dissertation's experiments did it where that differs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Variant {
+    /// The defaults: the 15-axis box test, spheres centred on their box.
+    #[default]
+    Standard,
+    /// Boxes tested as the dissertation tested AABBs: B's re-wrapped in a box aligned with
+    /// A's ([`BoxTest::Rewrapped`]).
+    Rewrapped,
+    /// Spheres centred on their smallest enclosing ball ([`SphereFit::Minimal`]).
+    MinimalSpheres,
+}
+
 /// One measured point: one volume type at one value of the experiment's parameter,
 /// averaged over its queries.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point {
     /// The volume type of both trees.
     pub bv: BvKind,
+    /// How they were built and tested.
+    pub variant: Variant,
     /// The experiment's parameter (an offset, a gap, a triangle count).
     pub x: f64,
     /// Queries averaged.
@@ -83,6 +99,17 @@ pub struct Point {
 }
 
 impl Point {
+    /// The setup's name: the volume type (`obb`, `aabb`, `sphere`), with `-rewrapped` or
+    /// `-minimal` for the dissertation's variants.
+    pub fn label(&self) -> String {
+        let suffix = match self.variant {
+            Variant::Standard => "",
+            Variant::Rewrapped => "-rewrapped",
+            Variant::MinimalSpheres => "-minimal",
+        };
+        format!("{}{suffix}", self.bv.name())
+    }
+
     /// Mean volume tests, D + I.
     pub fn bv_tests(&self) -> f64 {
         self.disjoint + self.overlap
@@ -182,11 +209,18 @@ pub fn fit_line(points: &[(f64, f64)]) -> Option<Line> {
 }
 
 /// The trees of the experiments: default builds (hull fit, OBB frames also tried on the
-/// model's axes) in f64, as the dissertation's were in double precision.
-fn tree(mesh: &TriMesh, bv: BvKind) -> Result<ObbtFile, BuildError> {
+/// model's axes) in f64, as the dissertation's were in double precision; minimal-ball
+/// spheres for [`Variant::MinimalSpheres`].
+fn tree(mesh: &TriMesh, bv: BvKind, variant: Variant) -> Result<ObbtFile, BuildError> {
+    let sphere_fit = if variant == Variant::MinimalSpheres {
+        SphereFit::Minimal
+    } else {
+        SphereFit::BoxCentre
+    };
     let options = BuildOptions {
         bv,
         precision: Precision::F64,
+        sphere_fit,
         ..BuildOptions::default()
     };
     build(mesh, &options, None)
@@ -205,6 +239,7 @@ struct Job<'t> {
     a: &'t ObbtFile,
     b: &'t ObbtFile,
     bv: BvKind,
+    variant: Variant,
     x: f64,
     poses: Vec<PosePair>,
 }
@@ -220,8 +255,16 @@ fn measure(jobs: &[Job<'_>]) -> Result<Vec<Point>, ExperimentError> {
     let results: Vec<Result<(usize, Stats, usize, f64), QueryError>> = queries
         .par_iter()
         .map_init(QueryContext::new, |context, &(j, job, [pa, pb])| {
+            let options = CollideOptions {
+                box_test: if job.variant == Variant::Rewrapped {
+                    BoxTest::Rewrapped
+                } else {
+                    BoxTest::SeparatingAxes
+                },
+                ..CollideOptions::default()
+            };
             let started = Instant::now();
-            let r = collide_files(job.a, pa, job.b, pb, &CollideOptions::default(), context)?;
+            let r = collide_files(job.a, pa, job.b, pb, &options, context)?;
             Ok((j, r.stats, r.pairs.len(), started.elapsed().as_secs_f64()))
         })
         .collect();
@@ -250,6 +293,7 @@ fn measure(jobs: &[Job<'_>]) -> Result<Vec<Point>, ExperimentError> {
             times.sort_by(f64::total_cmp);
             Point {
                 bv: job.bv,
+                variant: job.variant,
                 x: job.x,
                 queries: job.poses.len() as u32,
                 contacts: sum.tri_contact as f64 / n,
@@ -273,9 +317,15 @@ pub fn lower_bound(cells: f64, contacts: usize) -> f64 {
     2.0 * (cells / k).log2() + 2.0 * k - 1.0
 }
 
-/// The points of one volume type, in order of x.
+/// The points of one volume type with the default setup, in order of x.
 pub fn of_kind(points: &[Point], bv: BvKind) -> Vec<Point> {
-    points.iter().filter(|p| p.bv == bv).copied().collect()
+    of_variant(points, bv, Variant::Standard)
+}
+
+/// The points of one volume type and variant, in order of x.
+pub fn of_variant(points: &[Point], bv: BvKind, variant: Variant) -> Vec<Point> {
+    let kept = points.iter().filter(|p| p.bv == bv && p.variant == variant);
+    kept.copied().collect()
 }
 
 fn median(mut values: Vec<f64>) -> Option<f64> {

@@ -7,7 +7,7 @@
 
 use super::{
     fit_line, measure, of_kind, turned_pair, Comparison, ExperimentError, Fit, Job, Outcome, Point,
-    Size,
+    Size, Variant,
 };
 use crate::bv::BvKind;
 use crate::generate::{lat_long_sphere, Rng};
@@ -41,11 +41,11 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
     let mut points = Vec::new();
     let mut levels = Vec::new();
     for bv in BvKind::ALL {
-        let b = super::tree(&inner, bv)?;
+        let b = super::tree(&inner, bv, Variant::Standard)?;
         levels.push((bv, b.level_stats().map_err(ExperimentError::Levels)?));
         let trees = outers
             .iter()
-            .map(|outer| super::tree(outer, bv))
+            .map(|outer| super::tree(outer, bv, Variant::Standard))
             .collect::<Result<Vec<_>, _>>()?;
         let jobs: Vec<Job<'_>> = trees
             .iter()
@@ -54,6 +54,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
                 a,
                 b: &b,
                 bv,
+                variant: Variant::Standard,
                 x: gap,
                 poses: orientations.clone(),
             })

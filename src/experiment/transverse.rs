@@ -6,7 +6,7 @@
 
 use super::{
     fit_line, measure, of_kind, turned_pair, Comparison, ExperimentError, Fit, Job, Outcome, Point,
-    Size,
+    Size, Variant,
 };
 use crate::bv::BvKind;
 use crate::generate::{lat_long_sphere, Rng};
@@ -53,7 +53,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
     for bv in BvKind::ALL {
         let trees = meshes
             .iter()
-            .map(|mesh| super::tree(mesh, bv))
+            .map(|mesh| super::tree(mesh, bv, Variant::Standard))
             .collect::<Result<Vec<_>, _>>()?;
         let jobs: Vec<Job<'_>> = trees
             .iter()
@@ -63,6 +63,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
                 a: tree,
                 b: tree,
                 bv,
+                variant: Variant::Standard,
                 x: mesh.faces().len() as f64,
                 poses: poses.clone(),
             })

@@ -27,7 +27,7 @@ mod stats;
 pub mod triangle;
 
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
-pub use collide::{collide, collide_files, collide_into, CollideOptions, CollideResult};
+pub use collide::{collide, collide_files, collide_into, BoxTest, CollideOptions, CollideResult};
 pub use descent::DescentRule;
 pub use distance::{
     distance, distance_below, distance_files, within_tolerance, within_tolerance_files,

@@ -96,6 +96,15 @@ pub fn all_options() -> Vec<obbtree::build::BuildOptions> {
             }
         }
     }
+    // Spheres centred on their smallest ball: another centre, the same guarantees.
+    for precision in Precision::ALL {
+        out.push(BuildOptions {
+            bv: BvKind::Sphere,
+            precision,
+            sphere_fit: obbtree::build::SphereFit::Minimal,
+            ..BuildOptions::default()
+        });
+    }
     out
 }
 
