@@ -468,3 +468,66 @@ fn quick_transverse_contact_grows_as_the_square_root_of_the_tessellation() {
         }
     }
 }
+
+/// The accuracy experiment on the sliding spheres and the bundled cow: every answer is
+/// within what its choice promises against the exact f64 answer, the f64 tree's answers
+/// are the reference itself, and the Pareto marks are the undominated choices.
+#[test]
+fn quick_accuracy_keeps_every_choice_within_its_promise() {
+    let dir = scratch("experiment-accuracy");
+    let stdout = run(&[
+        "experiment",
+        "accuracy",
+        "--quick",
+        "--mesh",
+        &cow(),
+        "--out",
+        path(&dir),
+    ]);
+    assert!(stdout.contains("Pareto front"), "{stdout}");
+    let text = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
+    // The choice column is quoted and holds commas: split around it.
+    let trades: Vec<(String, String, String, f64, f64, bool)> = text
+        .lines()
+        .skip(1)
+        .map(|line| {
+            let (head, rest) = line.split_once(",\"").unwrap();
+            let (choice, tail) = rest.split_once("\",").unwrap();
+            let (scene, query) = head.split_once(',').unwrap();
+            let f: Vec<&str> = tail.split(',').collect();
+            (
+                scene.to_string(),
+                query.to_string(),
+                choice.to_string(),
+                f[0].parse().unwrap(),
+                f[2].parse().unwrap(),
+                f[4] == "true",
+            )
+        })
+        .collect();
+    let scenes: std::collections::BTreeSet<&str> = trades.iter().map(|t| t.0.as_str()).collect();
+    assert_eq!(scenes.into_iter().collect::<Vec<_>>(), ["cow", "spheres"]);
+    // f32 coordinates are within 6e-8 of the f64 ones: distances move by about that.
+    let storage = 1e-5;
+    for (scene, query, choice, _, error_max, _) in &trades {
+        let promise = if choice.starts_with("f64") {
+            0.0
+        } else if let Some(r) = choice.split("--rel-err ").nth(1) {
+            r.parse::<f64>().unwrap() + storage
+        } else if let Some(t) = choice.split("--tolerance (1 + ").nth(1) {
+            t.trim_end_matches(") d").parse::<f64>().unwrap() + storage
+        } else {
+            storage
+        };
+        assert!(
+            *error_max <= promise,
+            "{scene} {query} {choice}: {error_max} > {promise}"
+        );
+    }
+    for (scene, query, choice, seconds, error, pareto) in &trades {
+        let dominated = trades.iter().any(|(s, q, _, t, e, _)| {
+            s == scene && q == query && t <= seconds && e <= error && (t < seconds || e < error)
+        });
+        assert_eq!(*pareto, !dominated, "{scene} {query} {choice}");
+    }
+}

@@ -1,13 +1,14 @@
 //! `obbtree experiment`: the dissertation's chapter 5 experiments, run end to end, with
 //! their CSV files, plots and a table of measured against reported figures.
 
+use super::build::load_mesh;
 use super::files::write_file;
 use super::plot::{self, Chart, Series};
 use super::print::out;
 use super::{human_seconds, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::bv::BvKind;
-use obbtree::experiment::{self, of_kind, of_variant, Outcome, Point, Size, Variant};
+use obbtree::experiment::{self, accuracy, of_kind, of_variant, Outcome, Point, Size, Variant};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -40,7 +41,12 @@ pub struct ExperimentArgs {
     /// Seed of the random orientations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Threads that run the queries [default: one per core].
+    /// accuracy: also measure this mesh (.obj, .stl) against a turned copy of itself
+    /// (repeatable).
+    #[arg(long, value_name = "FILE")]
+    pub mesh: Vec<PathBuf>,
+    /// Threads that run the queries [default: one per core; accuracy times one query at
+    /// a time whatever this says].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..1025))]
     pub threads: Option<u32>,
 }
@@ -54,6 +60,10 @@ pub enum ExperimentArg {
     Proximity,
     /// Transverse contact against tessellation (§5.3.3.1).
     Transverse,
+    /// What accuracy costs in time: distance error allowed, tolerance queries, f32 or
+    /// f64, fit and leaf size, each timed (one query at a time) and held to an exact f64
+    /// answer, on the sliding spheres and each --mesh against a turned copy.
+    Accuracy,
 }
 
 pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
@@ -67,11 +77,13 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Failure(format!("{}: cannot create: {e}", args.out.display())))?;
     let started = Instant::now();
-    let experiment = || match args.experiment {
-        ExperimentArg::Sliding => experiment::sliding::run(size, args.seed),
-        ExperimentArg::Proximity => experiment::proximity::run(size, args.seed),
-        ExperimentArg::Transverse => experiment::transverse::run(size, args.seed),
+    let chapter_5 = match args.experiment {
+        ExperimentArg::Sliding => experiment::sliding::run,
+        ExperimentArg::Proximity => experiment::proximity::run,
+        ExperimentArg::Transverse => experiment::transverse::run,
+        ExperimentArg::Accuracy => return run_accuracy(args, size, started),
     };
+    let experiment = || chapter_5(size, args.seed);
     eprintln!(
         "running {:?}{} ...",
         args.experiment,
@@ -106,6 +118,140 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
         out!("wrote {}", path.display())?;
     }
     Ok(())
+}
+
+/// The accuracy experiment: its trades as CSV, two charts and a table.
+fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(), Failure> {
+    let mut scenes = vec![accuracy::spheres(size, args.seed)?];
+    for path in &args.mesh {
+        let mesh = load_mesh(path)?;
+        let name = path
+            .file_stem()
+            .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+        scenes.push(accuracy::turned_copy(&name, &mesh, args.seed));
+    }
+    eprintln!(
+        "running Accuracy{} ...",
+        if args.quick { " (quick)" } else { "" }
+    );
+    let repeat = if args.quick { 3 } else { 15 };
+    let trades = accuracy::run(&scenes, repeat)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let mut text =
+        String::from("scene,query,choice,seconds,error_mean,error_max,bv_tests,pareto\n");
+    for t in &trades {
+        text.push_str(&format!(
+            "{},{},\"{}\",{},{},{},{},{}\n",
+            t.scene, t.query, t.choice, t.seconds, t.error_mean, t.error_max, t.bv_tests, t.pareto
+        ));
+    }
+    let csv = args.out.join("accuracy.csv");
+    write_file(&csv, text.as_bytes())?;
+    let mut written = vec![csv];
+    for query in ["distance", "collision"] {
+        let path = args.out.join(format!("accuracy-{query}.svg"));
+        plot::write(&accuracy_chart(&trades, &scenes, query), &path)?;
+        written.push(path);
+    }
+    for scene in &scenes {
+        for query in ["distance", "collision"] {
+            let mut rows: Vec<&accuracy::Trade> = trades
+                .iter()
+                .filter(|t| t.scene == scene.name && t.query == query)
+                .collect();
+            rows.sort_by(|p, q| p.seconds.total_cmp(&q.seconds));
+            let poses = if query == "distance" {
+                scene.apart.len()
+            } else {
+                scene.crossing.len()
+            };
+            out!(
+                "{} {query} ({poses} poses; * on the Pareto front):",
+                scene.name
+            )?;
+            out!(
+                "  {:<40} {:>10} {:>12} {:>12} {:>10}",
+                "choice",
+                "time",
+                "error mean",
+                "error max",
+                "bv tests"
+            )?;
+            for t in rows {
+                out!(
+                    "  {:<40} {:>10} {:>12.2e} {:>12.2e} {:>10.0} {}",
+                    t.choice,
+                    human_seconds(t.seconds),
+                    t.error_mean,
+                    t.error_max,
+                    t.bv_tests,
+                    if t.pareto { "*" } else { "" }
+                )?;
+            }
+        }
+    }
+    out!("")?;
+    out!("ran in {}", human_seconds(seconds))?;
+    for path in written {
+        out!("wrote {}", path.display())?;
+    }
+    Ok(())
+}
+
+/// Errors below this are drawn at it: exact answers (0) have no place on a log axis.
+const ERROR_FLOOR: f64 = 1e-16;
+
+/// Time against the error incurred, one colour per scene, each choice labelled, and each
+/// scene's Pareto front as a line.
+fn accuracy_chart(
+    trades: &[accuracy::Trade],
+    scenes: &[accuracy::Scene],
+    query: &str,
+) -> Chart<'static> {
+    let mut series = Vec::new();
+    for (colour, scene) in scenes.iter().enumerate() {
+        let mine: Vec<&accuracy::Trade> = trades
+            .iter()
+            .filter(|t| t.scene == scene.name && t.query == query)
+            .collect();
+        let at = |t: &accuracy::Trade| (t.error_max.max(ERROR_FLOOR), t.seconds * 1e3);
+        series.push(Series {
+            name: scene.name.clone(),
+            points: mine.iter().map(|t| at(t)).collect(),
+            line: false,
+            colour,
+            labels: Vec::new(),
+        });
+        // The choices worth making, labelled: the rest are in the table.
+        let mut front: Vec<&&accuracy::Trade> = mine.iter().filter(|t| t.pareto).collect();
+        front.sort_by(|p, q| p.error_max.total_cmp(&q.error_max));
+        series.push(Series {
+            name: format!("{}: Pareto front", scene.name),
+            points: front.iter().map(|t| at(t)).collect(),
+            line: true,
+            colour,
+            labels: front.iter().map(|t| t.choice.replace("--", "")).collect(),
+        });
+    }
+    let (title, x_label) = if query == "distance" {
+        (
+            "Distance: time against the error incurred (exact at 1e-16)",
+            "largest relative error over the poses",
+        )
+    } else {
+        (
+            "Collision: time against the contacts missed or added (exact at 1e-16)",
+            "largest share of contacting pairs differing",
+        )
+    };
+    Chart {
+        title,
+        x_label,
+        y_label: "time for the poses (ms)",
+        log_x: true,
+        log_y: true,
+        series,
+    }
 }
 
 fn queries(outcome: &Outcome) -> u64 {
@@ -194,6 +340,7 @@ fn per_kind(outcome: &Outcome, value: impl Fn(&Point) -> Option<f64>) -> Vec<Ser
                 .collect(),
             line: false,
             colour,
+            labels: Vec::new(),
         })
         .collect()
 }
@@ -215,6 +362,7 @@ fn fitted(outcome: &Outcome, measure: &str) -> Vec<Series> {
                 points: vec![at(f.from), at(f.to)],
                 line: true,
                 colour: BvKind::ALL.iter().position(|&k| k == f.bv).unwrap_or(0),
+                labels: Vec::new(),
             }
         })
         .collect()
@@ -241,6 +389,7 @@ fn thickness(outcome: &Outcome) -> Vec<Series> {
                 .collect(),
             line: false,
             colour: BvKind::ALL.iter().position(|k| k == bv).unwrap_or(0),
+            labels: Vec::new(),
         })
         .collect();
     let obb = outcome.levels.iter().find(|(bv, _)| *bv == BvKind::Obb);
@@ -257,6 +406,7 @@ fn thickness(outcome: &Outcome) -> Vec<Series> {
             points: vec![at(2.0), at(last as f64)],
             line: true,
             colour: 5,
+            labels: Vec::new(),
         });
     }
     series
@@ -279,6 +429,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                 points: obb.iter().map(|p| (p.x, p.contacts)).collect(),
                 line: false,
                 colour: 0,
+                labels: Vec::new(),
             }];
             // The intersection curve's length times the least-squares factor.
             let (cl, ll) = obb.iter().fold((0.0, 0.0), |(cl, ll), p| {
@@ -294,6 +445,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                         .collect(),
                     line: true,
                     colour: 3,
+                    labels: Vec::new(),
                 });
             }
             let ratio = |bv, variant, colour| {
@@ -309,6 +461,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                         .map(|(s, o)| (s.x, s.bv_tests() / o.bv_tests()))
                         .collect(),
                     line: false,
+                    labels: Vec::new(),
                 }
             };
             vec![

@@ -16,6 +16,8 @@ pub struct Series {
     /// Index of its colour in the palette: a volume type's points and fitted line share
     /// one.
     pub colour: usize,
+    /// A label written beside each point (none if empty).
+    pub labels: Vec<String>,
 }
 
 /// A chart to draw.
@@ -74,11 +76,16 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
     if !(x0.is_finite() && y0.is_finite()) {
         return Err(Failure(format!("{}: nothing to plot", chart.title)));
     }
-    let pad = |lo: f64, hi: f64| {
+    let pad = |lo: f64, hi: f64, right: f64| {
         let span = if hi > lo { hi - lo } else { 1.0 };
-        (lo - 0.03 * span, hi + 0.03 * span)
+        (lo - 0.03 * span, hi + right * span)
     };
-    let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
+    // Labels are written to the right of their points: room for them.
+    let labelled = chart.series.iter().any(|s| !s.labels.is_empty());
+    let ((x0, x1), (y0, y1)) = (
+        pad(x0, x1, if labelled { 0.3 } else { 0.03 }),
+        pad(y0, y1, 0.03),
+    );
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, (760, 480)).into_drawing_area();
@@ -110,6 +117,15 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             let legend = move |(x, y): (i32, i32)| {
                 PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2))
             };
+            let labels = s.labels.iter().zip(points.iter());
+            c.draw_series(labels.map(|(label, &p)| {
+                Text::new(
+                    label.clone(),
+                    p,
+                    ("sans-serif", 10).into_font().color(&colour),
+                )
+            }))
+            .map_err(|e| fail(&e))?;
             if s.line {
                 c.draw_series(LineSeries::new(
                     points.iter().copied(),

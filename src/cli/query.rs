@@ -15,7 +15,6 @@ use obbtree::query::{
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// The two models and their poses, shared by every query command.
 #[derive(Args, Debug)]
@@ -236,22 +235,9 @@ fn bv_test_lower_bound(cells: f64, contacts: usize) -> Option<f64> {
 /// Runs `query` `repeat` times: its last answer, and the median time of one run.
 fn timed<T>(
     repeat: u32,
-    mut query: impl FnMut() -> Result<T, obbtree::query::QueryError>,
+    query: impl FnMut() -> Result<T, obbtree::query::QueryError>,
 ) -> Result<(T, f64), Failure> {
-    let mut times = Vec::with_capacity(repeat as usize);
-    let mut answer = None;
-    for _ in 0..repeat.max(1) {
-        let started = Instant::now();
-        let r = query()?;
-        times.push(started.elapsed().as_secs_f64());
-        answer = Some(r);
-    }
-    times.sort_by(f64::total_cmp);
-    let median = times.get(times.len() / 2).copied().unwrap_or(0.0);
-    match answer {
-        Some(r) => Ok((r, median)),
-        None => Err(Failure("no query ran".into())),
-    }
+    Ok(obbtree::experiment::median_time(repeat, query)?)
 }
 
 fn stats_text(s: &Stats) -> String {

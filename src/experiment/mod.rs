@@ -13,6 +13,7 @@
 //! D + I). Queries run on rayon's pool: in a pool of one thread the times are those of a
 //! query alone; with more they are inflated by the work beside them.
 
+pub mod accuracy;
 pub mod proximity;
 pub mod sliding;
 pub mod transverse;
@@ -326,6 +327,23 @@ pub fn of_kind(points: &[Point], bv: BvKind) -> Vec<Point> {
 pub fn of_variant(points: &[Point], bv: BvKind, variant: Variant) -> Vec<Point> {
     let kept = points.iter().filter(|p| p.bv == bv && p.variant == variant);
     kept.copied().collect()
+}
+
+/// Runs `query` `repeat` times (at least once): its last answer, and the median time of
+/// one run in seconds.
+pub fn median_time<T, E>(
+    repeat: u32,
+    mut query: impl FnMut() -> Result<T, E>,
+) -> Result<(T, f64), E> {
+    let started = Instant::now();
+    let mut answer = query()?;
+    let mut times = vec![started.elapsed().as_secs_f64()];
+    for _ in 1..repeat {
+        let started = Instant::now();
+        answer = query()?;
+        times.push(started.elapsed().as_secs_f64());
+    }
+    Ok((answer, median(times).unwrap_or(0.0)))
 }
 
 fn median(mut values: Vec<f64>) -> Option<f64> {

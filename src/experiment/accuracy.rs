@@ -1,0 +1,369 @@
+//! What accuracy costs in time: the choices that trade one for the other (the distance
+//! error allowed, tolerance queries, f32 or f64 storage, the fit, the leaf size), each
+//! measured by the time it takes and the error it actually incurs against an exact f64
+//! reference, on the sliding spheres and on any mesh against a turned copy of itself.
+//!
+//! A choice is worth making when no other is both faster and more accurate: the Pareto
+//! front of each scene's (error, time) points ([`Trade::pareto`]).
+
+use super::{median_time, turned_pair, ExperimentError, Size};
+use crate::build::{build, BuildOptions};
+use crate::fit::FitMethod;
+use crate::format::ObbtFile;
+use crate::generate::{lat_long_sphere, PosePair, Rng};
+use crate::mesh::TriMesh;
+use crate::query::{
+    collide_files, distance_files, within_tolerance_files, CollideOptions, DescentRule,
+    DistanceOptions, Pose, QueryContext, QueryError,
+};
+use crate::real::Precision;
+use nalgebra::Vector3;
+use std::collections::BTreeSet;
+
+/// Two models and the poses each query kind is measured at.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Its name in tables and files.
+    pub name: String,
+    /// Model A.
+    pub a: TriMesh,
+    /// Model B.
+    pub b: TriMesh,
+    /// Poses where the models are apart (distance queries).
+    pub apart: Vec<PosePair>,
+    /// Poses where they cross (collision queries).
+    pub crossing: Vec<PosePair>,
+}
+
+/// The sliding spheres (§5.3.1) at 8 separated positions (x from 1.85 to 2.2) and 3
+/// crossing ones (x = 0.5, 1.0, 1.5), both turned at random.
+pub fn spheres(size: Size, seed: u64) -> Result<Scene, ExperimentError> {
+    let (stacks, slices) = match size {
+        Size::Full => (101, 200),
+        Size::Quick => (21, 40),
+    };
+    let mut rng = Rng::new(seed);
+    let mut at = |x: f64| turned_pair(&mut rng, Vector3::new(x, 0.0, 0.0));
+    let apart = (0..8).map(|i| at(1.85 + 0.05 * f64::from(i))).collect();
+    let crossing = [0.5, 1.0, 1.5].map(&mut at).to_vec();
+    Ok(Scene {
+        name: "spheres".into(),
+        a: lat_long_sphere(1.0, stacks, slices)?,
+        b: lat_long_sphere(0.8, stacks, slices)?,
+        apart,
+        crossing,
+    })
+}
+
+/// `mesh` against a turned copy of itself: 8 poses with the copy's centre 1.1 bounding-box
+/// diagonals away in random directions, and 3 with it a quarter of a diagonal away.
+pub fn turned_copy(name: &str, mesh: &TriMesh, seed: u64) -> Scene {
+    let (lo, hi) = crate::arr3::bounds(mesh.vertices());
+    let diagonal = Vector3::from(crate::arr3::sub(hi, lo)).norm();
+    let centre = (Vector3::from(lo) + Vector3::from(hi)) / 2.0;
+    let mut rng = Rng::new(seed);
+    let mut at = |distance: f64| -> PosePair {
+        let direction = rng.uniform_rotation() * Vector3::x();
+        let turn = rng.uniform_rotation();
+        // B turned about its centre, which lands `distance` from A's.
+        let offset = centre + direction * distance - turn * centre;
+        [
+            Pose::identity(),
+            Pose::new(turn, offset).unwrap_or_default(),
+        ]
+    };
+    let apart = (0..8).map(|_| at(1.1 * diagonal)).collect();
+    let crossing = (0..3).map(|_| at(0.25 * diagonal)).collect();
+    Scene {
+        name: name.into(),
+        a: mesh.clone(),
+        b: mesh.clone(),
+        apart,
+        crossing,
+    }
+}
+
+/// One choice measured on one scene and query kind.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trade {
+    /// The scene's name.
+    pub scene: String,
+    /// `distance` or `collision`.
+    pub query: &'static str,
+    /// The choice, as the command line spells it (`f32, --rel-err 0.01`).
+    pub choice: String,
+    /// Seconds for the scene's poses: the sum over poses of each pose's median time.
+    pub seconds: f64,
+    /// The error incurred, mean over the poses: for distance the relative excess over the
+    /// exact f64 distance, for collision the share of contacting pairs that differ from
+    /// the exact f64 answer (gained or lost).
+    pub error_mean: f64,
+    /// The largest error over the poses.
+    pub error_max: f64,
+    /// Mean volume tests per query.
+    pub bv_tests: f64,
+    /// Whether no other choice of the same scene and query is at least as fast and at
+    /// least as accurate (by the largest error), and better in one.
+    pub pareto: bool,
+}
+
+/// A tree choice: storage precision, fit and leaf size.
+#[derive(Clone, Copy, Debug)]
+struct TreeChoice {
+    precision: Precision,
+    fit: FitMethod,
+    leaf_size: u32,
+}
+
+impl TreeChoice {
+    const DEFAULT: TreeChoice = TreeChoice {
+        precision: Precision::F32,
+        fit: FitMethod::Hull,
+        leaf_size: 1,
+    };
+
+    /// The flags that differ from the defaults.
+    fn flags(self) -> Vec<String> {
+        let mut flags = vec![self.precision.name().to_string()];
+        if self.fit != FitMethod::Hull {
+            flags.push(format!("--fit {}", self.fit.name()));
+        }
+        if self.leaf_size != 1 {
+            flags.push(format!("--leaf-size {}", self.leaf_size));
+        }
+        flags
+    }
+
+    fn options(self) -> BuildOptions {
+        BuildOptions {
+            precision: self.precision,
+            fit: self.fit,
+            leaf_size: self.leaf_size,
+            ..BuildOptions::default()
+        }
+    }
+}
+
+/// The tree choices measured: f32 and f64, the two other fits, and larger leaves.
+fn tree_choices() -> Vec<TreeChoice> {
+    let d = TreeChoice::DEFAULT;
+    vec![
+        d,
+        TreeChoice {
+            precision: Precision::F64,
+            ..d
+        },
+        TreeChoice {
+            fit: FitMethod::Triangles,
+            ..d
+        },
+        TreeChoice {
+            fit: FitMethod::Vertices,
+            ..d
+        },
+        TreeChoice { leaf_size: 4, ..d },
+        TreeChoice { leaf_size: 16, ..d },
+    ]
+}
+
+/// How a distance is asked for.
+#[derive(Clone, Copy, Debug)]
+enum Ask {
+    /// `--rel-err r` (0: exact).
+    RelErr(f64),
+    /// `--tolerance (1 + t) d*`: is the distance below a bound a share `t` above it? The
+    /// witness's distance is the answer measured.
+    Tolerance(f64),
+}
+
+impl Ask {
+    fn flag(self) -> String {
+        match self {
+            Ask::RelErr(0.0) => "exact".into(),
+            Ask::RelErr(r) => format!("--rel-err {r}"),
+            Ask::Tolerance(t) => format!("--tolerance (1 + {t}) d"),
+        }
+    }
+}
+
+/// The distance asks measured on the default tree (the others are asked exactly).
+const ASKS: [Ask; 8] = [
+    Ask::RelErr(0.0),
+    Ask::RelErr(1e-3),
+    Ask::RelErr(1e-2),
+    Ask::RelErr(0.05),
+    Ask::RelErr(0.1),
+    Ask::RelErr(0.3),
+    Ask::Tolerance(0.1),
+    Ask::Tolerance(1.0),
+];
+
+/// Runs every choice on every scene, one query at a time (the times are the point), each
+/// pose's time the median of `repeat` runs.
+pub fn run(scenes: &[Scene], repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
+    let mut trades = Vec::new();
+    for scene in scenes {
+        let mut scene_trades = measure_scene(scene, repeat)?;
+        mark_pareto(&mut scene_trades);
+        trades.extend(scene_trades);
+    }
+    Ok(trades)
+}
+
+fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
+    let exact = TreeChoice {
+        precision: Precision::F64,
+        ..TreeChoice::DEFAULT
+    };
+    let reference = trees(scene, exact)?;
+    let mut context = QueryContext::new();
+    // The exact f64 answers every choice is held to.
+    let mut distances = Vec::new();
+    for [pa, pb] in &scene.apart {
+        let r = distance_files(
+            &reference.0,
+            pa,
+            &reference.1,
+            pb,
+            &DistanceOptions::default(),
+            &mut context,
+        )?;
+        distances.push(r.distance);
+    }
+    let mut contacts = Vec::new();
+    for [pa, pb] in &scene.crossing {
+        let r = collide_files(
+            &reference.0,
+            pa,
+            &reference.1,
+            pb,
+            &CollideOptions::default(),
+            &mut context,
+        )?;
+        contacts.push(r.pairs.into_iter().collect::<BTreeSet<_>>());
+    }
+    let mut out = Vec::new();
+    for choice in tree_choices() {
+        let (a, b) = trees(scene, choice)?;
+        let asks: &[Ask] = if matches!(choice.precision, Precision::F32)
+            && choice.fit == FitMethod::Hull
+            && choice.leaf_size == 1
+        {
+            &ASKS
+        } else {
+            &[Ask::RelErr(0.0)]
+        };
+        for &ask in asks {
+            let mut trade = Trade {
+                scene: scene.name.clone(),
+                query: "distance",
+                choice: [choice.flags(), vec![ask.flag()]].concat().join(", "),
+                seconds: 0.0,
+                error_mean: 0.0,
+                error_max: 0.0,
+                bv_tests: 0.0,
+                pareto: false,
+            };
+            for ([pa, pb], &d) in scene.apart.iter().zip(&distances) {
+                let ((found, tests), seconds) =
+                    median_time(repeat, || -> Result<_, QueryError> {
+                        match ask {
+                            Ask::RelErr(rel_err) => {
+                                let options = DistanceOptions {
+                                    rel_err,
+                                    ..DistanceOptions::default()
+                                };
+                                let r = distance_files(&a, pa, &b, pb, &options, &mut context)?;
+                                Ok((r.distance, r.stats.bv_disjoint + r.stats.bv_overlap))
+                            }
+                            Ask::Tolerance(t) => {
+                                let rule = DescentRule::default();
+                                let r = within_tolerance_files(
+                                    &a,
+                                    pa,
+                                    &b,
+                                    pb,
+                                    (1.0 + t) * d,
+                                    rule,
+                                    &mut context,
+                                )?;
+                                let found = r.witness.map_or(f64::INFINITY, |w| w.distance);
+                                Ok((found, r.stats.bv_disjoint + r.stats.bv_overlap))
+                            }
+                        }
+                    })?;
+                let error = if d > 0.0 {
+                    (found - d).abs() / d
+                } else {
+                    found.abs()
+                };
+                add(&mut trade, seconds, error, tests);
+            }
+            finish(&mut trade, scene.apart.len());
+            out.push(trade);
+        }
+        let mut trade = Trade {
+            scene: scene.name.clone(),
+            query: "collision",
+            choice: choice.flags().join(", "),
+            seconds: 0.0,
+            error_mean: 0.0,
+            error_max: 0.0,
+            bv_tests: 0.0,
+            pareto: false,
+        };
+        for ([pa, pb], expected) in scene.crossing.iter().zip(&contacts) {
+            let ((found, tests), seconds) = median_time(repeat, || -> Result<_, QueryError> {
+                let r = collide_files(&a, pa, &b, pb, &CollideOptions::default(), &mut context)?;
+                let tests = r.stats.bv_disjoint + r.stats.bv_overlap;
+                Ok((r.pairs.into_iter().collect::<BTreeSet<_>>(), tests))
+            })?;
+            let differing = found.symmetric_difference(expected).count();
+            let error = differing as f64 / expected.len().max(1) as f64;
+            add(&mut trade, seconds, error, tests);
+        }
+        finish(&mut trade, scene.crossing.len());
+        out.push(trade);
+    }
+    Ok(out)
+}
+
+fn add(trade: &mut Trade, seconds: f64, error: f64, bv_tests: u64) {
+    trade.seconds += seconds;
+    trade.error_mean += error;
+    trade.error_max = trade.error_max.max(error);
+    trade.bv_tests += bv_tests as f64;
+}
+
+fn finish(trade: &mut Trade, poses: usize) {
+    let n = poses.max(1) as f64;
+    trade.error_mean /= n;
+    trade.bv_tests /= n;
+}
+
+/// Builds both models' trees for `choice`.
+fn trees(scene: &Scene, choice: TreeChoice) -> Result<(ObbtFile, ObbtFile), ExperimentError> {
+    let options = choice.options();
+    Ok((
+        build(&scene.a, &options, None)?,
+        build(&scene.b, &options, None)?,
+    ))
+}
+
+/// Marks the trades no other of the same query kind beats on both time and largest
+/// error.
+fn mark_pareto(trades: &mut [Trade]) {
+    let points: Vec<(&'static str, f64, f64)> = trades
+        .iter()
+        .map(|t| (t.query, t.seconds, t.error_max))
+        .collect();
+    for trade in trades.iter_mut() {
+        let dominated = points.iter().any(|&(query, seconds, error)| {
+            query == trade.query
+                && seconds <= trade.seconds
+                && error <= trade.error_max
+                && (seconds < trade.seconds || error < trade.error_max)
+        });
+        trade.pareto = !dominated;
+    }
+}
