@@ -52,9 +52,14 @@
 //! - [`format`](mod@format): the `.obbt` file: open (memory-mapped), verify, write;
 //! - [`query`]: collision, distance (exact, approximate, below a limit, tolerance) and
 //!   span between two posed trees; [`query::PairQuery`] for repeated queries of a pair;
+//! - [`scene`]: many models over frames, each pair asking for its own effect;
+//! - [`generate`]: the dissertation's test shapes, pose sweeps and random poses, and the
+//!   seeded generator behind them;
+//! - [`experiment`]: the dissertation's chapter 5 experiments and the accuracy–time
+//!   trade-off, as functions returning what they measured;
 //! - [`bv`], [`tree`], [`stats`], [`fit`], [`real`]: bounding volumes, the packed tree
-//!   view, the header's tree statistics, frame fitting and stored precision, for tools that
-//!   look inside a tree.
+//!   view, tree statistics (the header's, and level by level), frame fitting and stored
+//!   precision, for tools that look inside a tree.
 //!
 //! The library never panics on data it did not make: damaged files, meshes and poses
 //! give errors (see the README's robustness section).

@@ -245,30 +245,19 @@ fn info_levels_count_every_node_and_show_boxes_thinning() {
 fn generators_replay_from_their_seed_and_refuse_bad_requests_in_one_line() {
     let dir = scratch("generators");
     let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
-    run(&[
-        "poses",
-        "random",
-        "--count",
-        "20",
-        "--radius",
-        "2",
-        "--seed",
-        "11",
-        "-o",
-        path(&a),
-    ]);
-    run(&[
-        "poses",
-        "random",
-        "--count",
-        "20",
-        "--radius",
-        "2",
-        "--seed",
-        "11",
-        "-o",
-        path(&b),
-    ]);
+    for file in [&a, &b] {
+        let args = [
+            "--count",
+            "20",
+            "--radius",
+            "2",
+            "--seed",
+            "11",
+            "-o",
+            path(file),
+        ];
+        run(&[&["poses", "random"][..], &args].concat());
+    }
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     let stdout = run(&[
         "poses", "random", "--count", "20", "--radius", "2", "--seed", "11",

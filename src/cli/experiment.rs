@@ -5,7 +5,7 @@ use super::build::load_mesh;
 use super::files::write_file;
 use super::plot::{self, Chart, Series};
 use super::print::out;
-use super::{human_seconds, Failure};
+use super::{human_seconds, with_threads, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::bv::BvKind;
 use obbtree::experiment::{self, accuracy, of_kind, of_variant, Outcome, Point, Size, Variant};
@@ -89,14 +89,7 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
         args.experiment,
         if args.quick { " (quick)" } else { "" }
     );
-    let outcome = match args.threads {
-        None => experiment(),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n as usize)
-            .build()
-            .map_err(|e| Failure(format!("--threads {n}: {e}")))?
-            .install(experiment),
-    }?;
+    let outcome = with_threads(args.threads, experiment)??;
     let seconds = started.elapsed().as_secs_f64();
     let mut written = vec![write_csv(&outcome, &args.out)?];
     if !outcome.fits.is_empty() {

@@ -85,6 +85,22 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// Runs `work` on rayon's global pool, or on a pool of `threads` threads when given
+/// (`--threads N`).
+pub fn with_threads<T: Send>(
+    threads: Option<u32>,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T, Failure> {
+    match threads {
+        None => Ok(work()),
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build()
+            .map_err(|e| Failure(format!("--threads {n}: {e}")))?
+            .install(work)),
+    }
+}
+
 /// Bytes as a short human-readable size.
 pub fn human_bytes(n: u64) -> String {
     let mut value = n as f64;

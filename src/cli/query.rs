@@ -4,7 +4,7 @@ use super::build::{build_with_progress, load_mesh, TreeArgs};
 use super::files::is_obbt;
 use super::poses::PoseArgs;
 use super::print::{self, out};
-use super::{number, Failure};
+use super::{number, with_threads, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
 use obbtree::format::ObbtFile;
@@ -356,14 +356,7 @@ where
             })
             .collect()
     };
-    let answers = match inputs.threads {
-        None => run(),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n as usize)
-            .build()
-            .map_err(|e| Failure(format!("--threads {n}: {e}")))?
-            .install(run),
-    };
+    let answers = with_threads(inputs.threads, run)?;
     for (index, answer) in answers.into_iter().enumerate() {
         if print::closed() {
             break;
