@@ -1,9 +1,9 @@
 //! `obbtree build`: mesh file in, `.obbt` file out.
 
 use super::files::check_output;
+use super::progress::with_progress;
 use super::{human_bytes, Failure};
 use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use obbtree::build::{build, BuildOptions, SphereFit};
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
@@ -12,8 +12,8 @@ use obbtree::mesh::TriMesh;
 use obbtree::real::Precision;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::sync::atomic::AtomicU64;
+use std::time::Instant;
 
 /// Build the tree of a mesh and write it as one `.obbt` file.
 ///
@@ -222,48 +222,21 @@ pub fn build_with_progress(
     label: &str,
     quiet: bool,
 ) -> Result<ObbtFile, Failure> {
-    let total = mesh.faces().len() as u64;
+    let total = AtomicU64::new(mesh.faces().len() as u64);
     let done = AtomicU64::new(0);
     let show = !quiet && std::io::stderr().is_terminal();
-    std::thread::scope(|scope| {
-        let (sender, receiver) = std::sync::mpsc::channel();
-        let done = &done;
-        scope.spawn(move || {
-            // A panic here drops the sender, which the receiver reports as a crash below.
-            let _ = sender.send(build(mesh, options, Some(done)));
-        });
-        let started = Instant::now();
-        let mut bar: Option<ProgressBar> = None;
-        let outcome = loop {
-            match receiver.recv_timeout(Duration::from_millis(50)) {
-                Ok(result) => break Some(result),
-                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break None,
-                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
-            }
-            if show && bar.is_none() && started.elapsed() > Duration::from_secs(1) {
-                let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-                b.set_style(
-                    ProgressStyle::with_template(
-                        "{msg} [{bar:40}] {pos}/{len} triangles, {eta} left",
-                    )
-                    .unwrap_or_else(|_| ProgressStyle::default_bar())
-                    .progress_chars("=> "),
-                );
-                b.set_message(format!("building {label}"));
-                bar = Some(b);
-            }
-            if let Some(b) = &bar {
-                b.set_position(done.load(Ordering::Relaxed));
-            }
-        };
-        if let Some(b) = bar {
-            b.finish_and_clear();
-        }
-        match outcome {
-            Some(result) => result.map_err(|e| Failure(format!("{label}: {e}"))),
-            None => Err(Failure(format!("{label}: the builder crashed"))),
-        }
-    })
+    let work = || build(mesh, options, Some(&done));
+    match with_progress(
+        &format!("building {label}"),
+        "triangles",
+        show,
+        &done,
+        &total,
+        work,
+    ) {
+        Some(result) => result.map_err(|e| Failure(format!("{label}: {e}"))),
+        None => Err(Failure(format!("{label}: the builder crashed"))),
+    }
 }
 
 /// Loads a mesh file, naming it in any error.

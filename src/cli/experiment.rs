@@ -5,10 +5,14 @@ use super::build::load_mesh;
 use super::files::write_file;
 use super::plot::{self, Chart, Series};
 use super::print::out;
+use super::progress::with_progress;
 use super::{human_seconds, with_threads, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::bv::BvKind;
-use obbtree::experiment::{self, accuracy, of_kind, of_variant, Outcome, Point, Size, Variant};
+use obbtree::experiment::{
+    self, accuracy, of_kind, of_variant, Outcome, Point, Progress, Size, Variant,
+};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -83,13 +87,18 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
         ExperimentArg::Transverse => experiment::transverse::run,
         ExperimentArg::Accuracy => return run_accuracy(args, size, started),
     };
-    let experiment = || chapter_5(size, args.seed);
-    eprintln!(
-        "running {:?}{} ...",
+    let progress = Progress::default();
+    let experiment = || chapter_5(size, args.seed, Some(&progress));
+    let label = format!(
+        "{:?}{}",
         args.experiment,
         if args.quick { " (quick)" } else { "" }
     );
-    let outcome = with_threads(args.threads, experiment)??;
+    let show = std::io::stderr().is_terminal();
+    let (done, total) = (&progress.done, &progress.total);
+    let work = || with_threads(args.threads, experiment);
+    let outcome = with_progress(&label, "queries", show, done, total, work)
+        .ok_or_else(|| Failure(format!("{label}: the experiment crashed")))???;
     let seconds = started.elapsed().as_secs_f64();
     let mut written = vec![write_csv(&outcome, &args.out)?];
     if !outcome.fits.is_empty() {

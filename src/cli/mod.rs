@@ -10,6 +10,7 @@ mod info;
 mod plot;
 mod poses;
 mod print;
+mod progress;
 mod query;
 mod scene;
 mod verify;

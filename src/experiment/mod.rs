@@ -28,7 +28,26 @@ use crate::real::Precision;
 use crate::stats::LevelStats;
 use nalgebra::Vector3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+
+/// How far an experiment has got, for a progress display on another thread: queries done
+/// of the queries it will run (set when it starts).
+#[derive(Debug, Default)]
+pub struct Progress {
+    /// Queries run so far.
+    pub done: AtomicU64,
+    /// Queries the experiment runs in all.
+    pub total: AtomicU64,
+}
+
+impl Progress {
+    fn plan(progress: Option<&Progress>, queries: u64) {
+        if let Some(p) = progress {
+            p.total.fetch_add(queries, Ordering::Relaxed);
+        }
+    }
+}
 
 /// How large an experiment is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -246,8 +265,8 @@ struct Job<'t> {
 }
 
 /// Runs every job's queries (in parallel over all queries of all jobs) and averages each
-/// job's into a [`Point`].
-fn measure(jobs: &[Job<'_>]) -> Result<Vec<Point>, ExperimentError> {
+/// job's into a [`Point`], counting each query done in `progress`.
+fn measure(jobs: &[Job<'_>], progress: Option<&Progress>) -> Result<Vec<Point>, ExperimentError> {
     let queries: Vec<(usize, &Job<'_>, &PosePair)> = jobs
         .iter()
         .enumerate()
@@ -266,7 +285,11 @@ fn measure(jobs: &[Job<'_>]) -> Result<Vec<Point>, ExperimentError> {
             };
             let started = Instant::now();
             let r = collide_files(job.a, pa, job.b, pb, &options, context)?;
-            Ok((j, r.stats, r.pairs.len(), started.elapsed().as_secs_f64()))
+            let seconds = started.elapsed().as_secs_f64();
+            if let Some(p) = progress {
+                p.done.fetch_add(1, Ordering::Relaxed);
+            }
+            Ok((j, r.stats, r.pairs.len(), seconds))
         })
         .collect();
     let mut sums = vec![(Stats::default(), 0.0f64, Vec::new()); jobs.len()];

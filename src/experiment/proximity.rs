@@ -7,7 +7,7 @@
 
 use super::{
     fit_line, measure, of_kind, turned_pair, Comparison, ExperimentError, Fit, Job, Outcome, Point,
-    Size, Variant,
+    Progress, Size, Variant,
 };
 use crate::bv::BvKind;
 use crate::generate::{lat_long_sphere, Rng};
@@ -21,8 +21,8 @@ use nalgebra::Vector3;
 /// The ideal spheres never meet, but their polyhedra do once the gap is below the depth
 /// of a facet under the sphere (about 1e-4 at 40,000 triangles): the smallest gaps count
 /// contacts too.
-pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
-    let (stacks, slices, per_decade, decades, queries) = match size {
+pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
+    let (stacks, slices, per_decade, decades, queries): (u32, u32, i32, i32, u32) = match size {
         Size::Full => (101, 200, 4, 9, 100),
         Size::Quick => (51, 100, 4, 5, 8),
     };
@@ -38,6 +38,8 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
     let orientations: Vec<_> = (0..queries)
         .map(|_| turned_pair(&mut rng, Vector3::zeros()))
         .collect();
+    let per_kind = gaps.len() as u64 * u64::from(queries);
+    Progress::plan(progress, per_kind * BvKind::ALL.len() as u64);
     let mut points = Vec::new();
     let mut levels = Vec::new();
     for bv in BvKind::ALL {
@@ -59,7 +61,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
                 poses: orientations.clone(),
             })
             .collect();
-        let mut measured = measure(&jobs)?;
+        let mut measured = measure(&jobs, progress)?;
         // Smallest gap first, as the dissertation plots it.
         measured.reverse();
         points.extend(measured);

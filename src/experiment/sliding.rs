@@ -4,7 +4,7 @@
 
 use super::{
     measure, median, of_kind, of_variant, turned_pair, Comparison, ExperimentError, Job, Outcome,
-    Point, Size, Variant,
+    Point, Progress, Size, Variant,
 };
 use crate::bv::BvKind;
 use crate::generate::{lat_long_sphere, Rng};
@@ -22,7 +22,7 @@ pub const VARIANTS: [(BvKind, Variant); 2] = [
 
 /// Runs the experiment: 40,000-triangle spheres and 1,001 positions at full size;
 /// 1,600-triangle spheres and 101 positions quick. `seed` draws the orientations.
-pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
+pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, slices, steps) = match size {
         Size::Full => (101, 200, 1000u32),
         Size::Quick => (21, 40, 100),
@@ -37,6 +37,10 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
             (x, turned_pair(&mut rng, Vector3::new(x, 0.0, 0.0)))
         })
         .collect();
+    Progress::plan(
+        progress,
+        poses.len() as u64 * (BvKind::ALL.len() + VARIANTS.len()) as u64,
+    );
     let mut points = Vec::new();
     let setups = BvKind::ALL
         .map(|bv| (bv, Variant::Standard))
@@ -58,7 +62,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
                 poses: vec![pair],
             })
             .collect();
-        points.extend(measure(&jobs)?);
+        points.extend(measure(&jobs, progress)?);
     }
     let comparisons = compare(&points);
     Ok(Outcome {

@@ -6,7 +6,7 @@
 
 use super::{
     fit_line, measure, of_kind, turned_pair, Comparison, ExperimentError, Fit, Job, Outcome, Point,
-    Size, Variant,
+    Progress, Size, Variant,
 };
 use crate::bv::BvKind;
 use crate::generate::{lat_long_sphere, Rng};
@@ -22,7 +22,7 @@ const FIT_FROM: f64 = 500.0;
 /// Runs the experiment: spheres of 80 to about 600,000 triangles (stacks 5 to 388, twice
 /// as many slices) with 1,000 queries each at full size (200 from 100,000 triangles);
 /// 80 to 6,240 triangles with 20 queries quick. `seed` draws the orientations.
-pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
+pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, queries): (&[u32], u32) = match size {
         Size::Full => (
             &[5, 7, 10, 14, 20, 28, 40, 57, 80, 113, 160, 226, 320, 388],
@@ -49,6 +49,8 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
                 .collect()
         })
         .collect();
+    let per_kind: usize = poses.iter().map(Vec::len).sum();
+    Progress::plan(progress, (per_kind * BvKind::ALL.len()) as u64);
     let mut points = Vec::new();
     for bv in BvKind::ALL {
         let trees = meshes
@@ -68,7 +70,7 @@ pub fn run(size: Size, seed: u64) -> Result<Outcome, ExperimentError> {
                 poses: poses.clone(),
             })
             .collect();
-        points.extend(measure(&jobs)?);
+        points.extend(measure(&jobs, progress)?);
     }
     let mut fits = Vec::new();
     for bv in BvKind::ALL {
