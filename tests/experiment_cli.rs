@@ -312,6 +312,40 @@ fn generators_replay_from_their_seed_and_refuse_bad_requests_in_one_line() {
         "poses",
     );
     assert!(!mesh.exists());
+    assert_bad_input(
+        &obbtree(&[
+            "experiment",
+            "sliding",
+            "--quick",
+            "--mesh",
+            &cow(),
+            "--out",
+            path(&dir),
+        ]),
+        "--mesh applies to the accuracy experiment only",
+    );
+    assert_bad_input(
+        &obbtree(&[
+            "experiment",
+            "sliding",
+            "--quick",
+            "--out",
+            path(&dir.join("a.txt")),
+        ]),
+        "is not a directory",
+    );
+    assert_bad_input(
+        &obbtree(&[
+            "experiment",
+            "accuracy",
+            "--quick",
+            "--mesh",
+            path(&dir.join("none.obj")),
+            "--out",
+            path(&dir),
+        ]),
+        "none.obj",
+    );
     run(&["mesh", "box", "--half", "1", "2", "3", "-o", path(&mesh)]);
     let o = obbtree(&[
         "build",

@@ -72,6 +72,11 @@ pub enum ExperimentArg {
 
 pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
     let size = if args.quick { Size::Quick } else { Size::Full };
+    if !args.mesh.is_empty() && !matches!(args.experiment, ExperimentArg::Accuracy) {
+        return Err(Failure(
+            "--mesh applies to the accuracy experiment only".into(),
+        ));
+    }
     if args.out.exists() && !args.out.is_dir() {
         return Err(Failure(format!(
             "{}: is not a directory",
