@@ -87,8 +87,9 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
     let pick = data.iter().fold(0usize, |h, &b| {
         h.wrapping_mul(31).wrapping_add(usize::from(b))
     });
+    let bv = [BvKind::Obb, BvKind::Aabb, BvKind::Sphere][pick % 3];
     let other = BuildOptions {
-        bv: [BvKind::Obb, BvKind::Aabb, BvKind::Sphere][pick % 3],
+        bv,
         precision: [Precision::F32, Precision::F64][(pick / 3) % 2],
         fit: [FitMethod::Hull, FitMethod::Triangles, FitMethod::Vertices][(pick / 6) % 3],
         leaf_size: [1, 2, 4, 128][(pick / 18) % 4],
@@ -98,7 +99,12 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         // Small enough that fuzzed meshes get sampled hulls too.
         hull_max_points: [4, DEFAULT_HULL_MAX_POINTS][(pick / 864) % 2],
         model_axes: (pick / 1728) % 2 == 0,
-        sphere_fit: [SphereFit::BoxCentre, SphereFit::Minimal][(pick / 3456) % 2],
+        // Minimal balls apply to sphere trees only.
+        sphere_fit: if bv == BvKind::Sphere && (pick / 3456) % 2 == 1 {
+            SphereFit::Minimal
+        } else {
+            SphereFit::BoxCentre
+        },
     };
     // Fuzzed meshes are small: with the default threshold the hull fit would never run.
     let hull_everywhere = BuildOptions {

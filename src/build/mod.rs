@@ -144,8 +144,8 @@ impl BuildOptions {
     }
 
     /// The checks of the options alone, before any mesh is read: `leaf_size` in 1..=128,
-    /// `hull_min_faces` at least 1, `hull_max_points` at least 4 and a finite `scale`
-    /// greater than 0. [`build`] runs them too.
+    /// `hull_min_faces` at least 1, `hull_max_points` at least 4, a finite `scale`
+    /// greater than 0, and minimal spheres only for sphere trees. [`build`] runs them too.
     pub fn validate(&self) -> Result<(), BuildError> {
         if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&self.leaf_size) {
             return Err(BuildError::LeafSize(self.leaf_size));
@@ -158,6 +158,9 @@ impl BuildOptions {
         }
         if !Placement::is_valid_scale(self.scale) {
             return Err(BuildError::Scale(self.scale));
+        }
+        if self.sphere_fit == SphereFit::Minimal && self.bv != BvKind::Sphere {
+            return Err(BuildError::SphereFit(self.bv));
         }
         Ok(())
     }
@@ -179,6 +182,9 @@ pub enum BuildError {
     /// `scale` is not a finite number greater than 0.
     #[error("scale {0} is not a finite number greater than 0 (--scale)")]
     Scale(f64),
+    /// Minimal spheres asked for a tree of another volume type.
+    #[error("--sphere-fit minimal applies to sphere trees, not to {} trees (--bv sphere)", .0.name())]
+    SphereFit(BvKind),
     /// The mesh is too large for the 32-bit references of the file format.
     #[error("the mesh is too large for the .obbt format: {0}")]
     TooLarge(#[from] EncodeError),

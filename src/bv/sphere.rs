@@ -97,7 +97,8 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         Self::enclose_points(frame, listed_vertices(positions, vertices))
     }
 
-    /// Centred on the smallest ball's centre ([`super::ball`]); the radius measured from it.
+    /// Centred on the smallest ball's centre (Welzl's algorithm); the radius measured from
+    /// it.
     fn enclose_vertices_minimal_ball(positions: &[[f64; 3]], vertices: &[u32]) -> Option<Self> {
         let points = listed_vertices(positions, vertices);
         let center = super::ball::minimal_ball_center(points.clone());

@@ -21,10 +21,11 @@ use std::time::Instant;
 ///
 /// sliding: a sphere of radius 0.8 slides through a unit sphere (§5.3.1), both turned at
 /// random at each of 1,001 steps; all contacts found at each step.
-/// proximity: a unit sphere inside a sphere of radius 1 + gap (§5.3.2), gaps from 1 to
+/// proximity: a unit sphere inside a sphere of radius 1 + gap (§5.3.2), gaps from 100 to
 /// 1e-7; the slope of volume tests against the gap on log-log axes.
 /// transverse: two unit spheres meeting at right angles (§5.3.3.1), 80 to 600,000
 /// triangles; how contacts and volume tests grow with the tessellation.
+/// accuracy: what each choice that trades accuracy for time costs (see its value below).
 ///
 /// Queries run in parallel over --threads (default: one per core); the counts do not
 /// depend on it, the times do (take them with --threads 1).
@@ -83,8 +84,6 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
             args.out.display()
         )));
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| Failure(format!("{}: cannot create: {e}", args.out.display())))?;
     let started = Instant::now();
     let chapter_5 = match args.experiment {
         ExperimentArg::Sliding => experiment::sliding::run,
@@ -105,6 +104,7 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
     let outcome = with_progress(&label, "queries", show, done, total, work)
         .ok_or_else(|| Failure(format!("{label}: the experiment crashed")))???;
     let seconds = started.elapsed().as_secs_f64();
+    create_out(&args.out)?;
     let mut written = vec![write_csv(&outcome, &args.out)?];
     if !outcome.fits.is_empty() {
         written.push(write_fits(&outcome, &args.out)?);
@@ -114,7 +114,7 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
         plot::write(&chart, &path)?;
         written.push(path);
     }
-    print_table(&outcome)?;
+    print_table(&outcome, args.quick)?;
     out!("")?;
     out!(
         "ran in {} ({} queries)",
@@ -135,6 +135,13 @@ fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(
         let name = path
             .file_stem()
             .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+        // Scenes are told apart by name in the table, the CSV and the plots.
+        if scenes.iter().any(|s| s.name == name) {
+            return Err(Failure(format!(
+                "{}: a scene named {name:?} is already measured (--mesh files need distinct names)",
+                path.display()
+            )));
+        }
         scenes.push(accuracy::turned_copy(&name, &mesh, args.seed));
     }
     eprintln!(
@@ -144,12 +151,24 @@ fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(
     let repeat = if args.quick { 3 } else { 15 };
     let trades = accuracy::run(&scenes, repeat)?;
     let seconds = started.elapsed().as_secs_f64();
-    let mut text =
-        String::from("scene,query,choice,seconds,error_mean,error_max,bv_tests,pareto\n");
+    create_out(&args.out)?;
+    // Times are summed over the scene's poses (each pose's median); errors are relative
+    // excesses of the distance, or shares of contacting pairs differing.
+    let mut text = String::from(
+        "scene,query,choice,seconds_all_poses,error_mean,error_max,bv_tests_mean,pareto\n",
+    );
+    let quoted = |field: &str| format!("\"{}\"", field.replace('"', "\"\""));
     for t in &trades {
         text.push_str(&format!(
-            "{},{},\"{}\",{},{},{},{},{}\n",
-            t.scene, t.query, t.choice, t.seconds, t.error_mean, t.error_max, t.bv_tests, t.pareto
+            "{},{},{},{},{},{},{},{}\n",
+            quoted(&t.scene),
+            t.query,
+            quoted(&t.choice),
+            t.seconds,
+            t.error_mean,
+            t.error_max,
+            t.bv_tests,
+            t.pareto
         ));
     }
     let csv = args.out.join("accuracy.csv");
@@ -172,8 +191,13 @@ fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(
             } else {
                 scene.crossing.len()
             };
+            let error = if query == "distance" {
+                "relative excess of the distance"
+            } else {
+                "share of contacting pairs gained or lost"
+            };
             out!(
-                "{} {query} ({poses} poses; * on the Pareto front):",
+                "{} {query} ({poses} poses; time summed over them; error: {error}; * on the Pareto front):",
                 scene.name
             )?;
             out!(
@@ -261,11 +285,18 @@ fn accuracy_chart(
     }
 }
 
+/// Creates the output directory once the experiment has run, so that a failed run leaves
+/// nothing behind.
+fn create_out(dir: &Path) -> Result<(), Failure> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Failure(format!("{}: cannot create: {e}", dir.display())))
+}
+
 fn queries(outcome: &Outcome) -> u64 {
     outcome.points.iter().map(|p| u64::from(p.queries)).sum()
 }
 
-fn print_table(outcome: &Outcome) -> Result<(), Failure> {
+fn print_table(outcome: &Outcome, quick: bool) -> Result<(), Failure> {
     let width = |column: fn(&experiment::Comparison) -> &str| {
         let cells = outcome
             .comparisons
@@ -275,6 +306,9 @@ fn print_table(outcome: &Outcome) -> Result<(), Failure> {
     };
     let (what, reported) = (width(|c| &c.what), width(|c| &c.dissertation).max(12));
     out!("{}: measured against the dissertation", outcome.name)?;
+    if quick {
+        out!("  (--quick: smaller meshes and fewer queries, so sizes and counts differ by construction)")?;
+    }
     out!("  {:<what$}  {:<reported$}  measured", "", "dissertation")?;
     for c in &outcome.comparisons {
         out!(
@@ -289,10 +323,18 @@ fn print_table(outcome: &Outcome) -> Result<(), Failure> {
 
 /// The CSV of every point: one row per volume type and parameter value.
 fn write_csv(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
-    let mut text = String::from(
-        "volume,x,queries,contacts,bv_disjoint,bv_overlap,tri_separated,tri_contact,bv_tests,tri_tests,bv_test_lower_bound,seconds\n",
+    // Means of the queries at each point; the time is the median of one query.
+    let mut text = format!(
+        "volume,{},queries,contacts,bv_disjoint,bv_overlap,tri_separated,tri_contact,bv_tests,tri_tests,bv_test_lower_bound,seconds\n",
+        outcome.x_column
     );
     for p in &outcome.points {
+        // No contacts, no bound: an empty field, as `collide --csv` writes it.
+        let bound = if p.lower_bound > 0.0 {
+            p.lower_bound.to_string()
+        } else {
+            String::new()
+        };
         text.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{}\n",
             p.label(),
@@ -305,7 +347,7 @@ fn write_csv(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
             p.contacts,
             p.bv_tests(),
             p.tri_tests(),
-            p.lower_bound,
+            bound,
             p.seconds
         ));
     }
@@ -476,7 +518,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "contacts",
                     chart(
                         "Contacts as the small sphere moves (Fig. 5.4)",
-                        "x",
+                        outcome.x_name,
                         "contacting triangle pairs",
                         false,
                         false,
@@ -487,7 +529,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "bv-tests",
                     chart(
                         "Volume tests (Fig. 5.5)",
-                        "x",
+                        outcome.x_name,
                         "volume tests",
                         false,
                         true,
@@ -498,7 +540,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "ratios",
                     chart(
                         "Volume tests over OBB's (Fig. 5.7)",
-                        "x",
+                        outcome.x_name,
                         "ratio",
                         false,
                         true,
@@ -514,7 +556,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "contact-cost",
                     chart(
                         "Contact cost: volume tests per contact (Fig. 5.8)",
-                        "x",
+                        outcome.x_name,
                         "volume tests per contact",
                         false,
                         true,
@@ -533,7 +575,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "bv-tests",
                     chart(
                         "Parallel close proximity (Fig. 5.11)",
-                        "gap",
+                        outcome.x_name,
                         "volume tests (mean)",
                         true,
                         true,
@@ -563,7 +605,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "contacts",
                     chart(
                         "Contacts against tessellation (Fig. 5.21)",
-                        "triangles per sphere",
+                        outcome.x_name,
                         "contacts (mean)",
                         true,
                         true,
@@ -574,7 +616,7 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                     "bv-tests",
                     chart(
                         "Volume tests against tessellation (Fig. 5.22)",
-                        "triangles per sphere",
+                        outcome.x_name,
                         "volume tests (mean)",
                         true,
                         true,

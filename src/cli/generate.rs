@@ -22,11 +22,16 @@ use std::path::{Path, PathBuf};
 pub struct MeshArgs {
     #[command(subcommand)]
     pub shape: ShapeCommand,
+}
+
+/// Where a shape is written.
+#[derive(Args, Debug)]
+pub struct MeshOutput {
     /// Output mesh (.obj).
-    #[arg(short, long, value_name = "OUT.obj", global = true)]
-    pub output: Option<PathBuf>,
+    #[arg(short, long, value_name = "OUT.obj")]
+    pub output: PathBuf,
     /// Replace OUT if it exists.
-    #[arg(long, global = true)]
+    #[arg(long)]
     pub force: bool,
 }
 
@@ -45,6 +50,8 @@ pub enum ShapeCommand {
         /// Sectors around the poles' axis (at least 3).
         #[arg(long, default_value_t = 200)]
         slices: u32,
+        #[command(flatten)]
+        out: MeshOutput,
     },
     /// A flat plate in the z = 0 plane, centred on the origin, cut into squares of two
     /// triangles: 2 · cells-x · cells-y triangles.
@@ -55,6 +62,8 @@ pub enum ShapeCommand {
         /// Cells along x and along y.
         #[arg(long, num_args = 2, value_names = ["NX", "NY"], default_values_t = [100, 100])]
         cells: Vec<u32>,
+        #[command(flatten)]
+        out: MeshOutput,
     },
     /// An axis-aligned box: 12 triangles.
     Box {
@@ -64,6 +73,8 @@ pub enum ShapeCommand {
         /// Centre, model units.
         #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], default_values_t = [0.0, 0.0, 0.0], allow_negative_numbers = true)]
         center: Vec<f64>,
+        #[command(flatten)]
+        out: MeshOutput,
     },
 }
 
@@ -150,9 +161,12 @@ fn three(values: &[f64]) -> [f64; 3] {
 }
 
 pub fn mesh(args: &MeshArgs) -> Result<(), Failure> {
-    let Some(output) = &args.output else {
-        return Err(Failure("mesh: -o OUT.obj is required".into()));
+    let out = match &args.shape {
+        ShapeCommand::Sphere { out, .. }
+        | ShapeCommand::Plate { out, .. }
+        | ShapeCommand::Box { out, .. } => out,
     };
+    let output = &out.output;
     if !output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
@@ -162,19 +176,20 @@ pub fn mesh(args: &MeshArgs) -> Result<(), Failure> {
             output.display()
         )));
     }
-    check_new_output(output, args.force)?;
+    check_new_output(output, out.force)?;
     let mesh = match &args.shape {
         ShapeCommand::Sphere {
             radius,
             stacks,
             slices,
+            ..
         } => lat_long_sphere(*radius, *stacks, *slices)?,
-        ShapeCommand::Plate { size, cells } => {
+        ShapeCommand::Plate { size, cells, .. } => {
             let size = [0, 1].map(|k| size.get(k).copied().unwrap_or(f64::NAN));
             let cells = [0, 1].map(|k| cells.get(k).copied().unwrap_or(0));
             plate(size, cells)?
         }
-        ShapeCommand::Box { half, center } => cuboid(three(half), three(center))?,
+        ShapeCommand::Box { half, center, .. } => cuboid(three(half), three(center))?,
     };
     write(output, mesh.to_obj().as_bytes())?;
     summary(output, &mesh)

@@ -40,6 +40,9 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(90, 90, 90),
 ];
 
+/// A point in chart coordinates (log10 on a log axis), with its label if it has one.
+type Drawn<'a> = ((f64, f64), Option<&'a String>);
+
 /// Draws `chart` into the SVG text it returns. Values that a logarithmic axis cannot show
 /// (0 and below) are left out.
 pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
@@ -50,20 +53,25 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             Some(v)
         }
     };
-    let series: Vec<(&Series, Vec<(f64, f64)>)> = chart
+    // Each series' drawable points, each with its label if it has one: a point left out
+    // takes its label with it.
+    let series: Vec<(&Series, Vec<Drawn<'_>>)> = chart
         .series
         .iter()
         .map(|s| {
             let points = s
                 .points
                 .iter()
-                .filter_map(|&(x, y)| Some((axis(x, chart.log_x)?, axis(y, chart.log_y)?)))
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .enumerate()
+                .filter_map(|(k, &(x, y))| {
+                    let p = (axis(x, chart.log_x)?, axis(y, chart.log_y)?);
+                    (p.0.is_finite() && p.1.is_finite()).then(|| (p, s.labels.get(k)))
+                })
                 .collect();
             (s, points)
         })
         .collect();
-    let all = series.iter().flat_map(|(_, p)| p.iter().copied());
+    let all = series.iter().flat_map(|(_, p)| p.iter().map(|&(p, _)| p));
     let (x0, x1, y0, y1) = all.fold(
         (
             f64::INFINITY,
@@ -117,8 +125,8 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             let legend = move |(x, y): (i32, i32)| {
                 PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2))
             };
-            let labels = s.labels.iter().zip(points.iter());
-            c.draw_series(labels.map(|(label, &p)| {
+            let labels = points.iter().filter_map(|&(p, label)| Some((label?, p)));
+            c.draw_series(labels.map(|(label, p)| {
                 Text::new(
                     label.clone(),
                     p,
@@ -128,7 +136,7 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             .map_err(|e| fail(&e))?;
             if s.line {
                 c.draw_series(LineSeries::new(
-                    points.iter().copied(),
+                    points.iter().map(|&(p, _)| p),
                     colour.stroke_width(2),
                 ))
                 .map_err(|e| fail(&e))?
@@ -138,7 +146,7 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
                 c.draw_series(
                     points
                         .iter()
-                        .map(|&p| Circle::new(p, 2, colour.mix(0.7).filled())),
+                        .map(|&(p, _)| Circle::new(p, 2, colour.mix(0.7).filled())),
                 )
                 .map_err(|e| fail(&e))?
                 .label(s.name.as_str())
@@ -146,7 +154,11 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
             }
         }
         c.configure_series_labels()
-            .position(emptiest_corner(&series, (x0, x1), (y0, y1)))
+            .position(emptiest_corner(
+                series.iter().flat_map(|(_, p)| p.iter().map(|&(p, _)| p)),
+                (x0, x1),
+                (y0, y1),
+            ))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -159,7 +171,7 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
 /// Where the legend covers the fewest points: the corner (a third of the width, 40% of
 /// the height) holding the fewest, the upper right on ties.
 fn emptiest_corner(
-    series: &[(&Series, Vec<(f64, f64)>)],
+    points: impl Iterator<Item = (f64, f64)> + Clone,
     (x0, x1): (f64, f64),
     (y0, y1): (f64, f64),
 ) -> SeriesLabelPosition {
@@ -174,10 +186,8 @@ fn emptiest_corner(
         (if right { u > 2.0 / 3.0 } else { u < 1.0 / 3.0 })
             && (if upper { v > 0.6 } else { v < 0.4 })
     };
-    let covered = |right: bool, upper: bool| {
-        let points = series.iter().flat_map(|(_, p)| p.iter());
-        points.filter(|&&p| inside(p, right, upper)).count()
-    };
+    let covered =
+        |right: bool, upper: bool| points.clone().filter(|&p| inside(p, right, upper)).count();
     corners
         .into_iter()
         .min_by_key(|&(_, right, upper)| covered(right, upper))

@@ -105,8 +105,8 @@ pub struct CollideArgs {
     /// Stop at the first contact found (yes/no with one witness pair).
     #[arg(long)]
     pub first: bool,
-    /// List the contacting pairs (input-mesh triangle ids).
-    #[arg(long)]
+    /// List the contacting pairs (input-mesh triangle ids; not with --csv).
+    #[arg(long, conflicts_with = "csv")]
     pub pairs: bool,
     /// How box pairs are tested (for experiments; the answer is the same, the work not).
     #[arg(long, value_enum, default_value_t = BoxTestArg::Sat)]
@@ -222,14 +222,6 @@ fn stats_json(s: &Stats) -> Value {
         "bv_tests": s.bv_disjoint + s.bv_overlap,
         "tri_tests": s.tri_separated + s.tri_contact,
     })
-}
-
-/// The least number of box tests that can locate `contacts` contacting pairs among the
-/// `cells` triangle pairs of two models (dissertation §2.6.3: ideal volumes, balanced
-/// trees, the contacts in one block): `2 log2(cells / k) + 2k − 1`, for `k > 0`.
-fn bv_test_lower_bound(cells: f64, contacts: usize) -> Option<f64> {
-    let k = contacts as f64;
-    (contacts > 0).then(|| 2.0 * (cells / k).log2() + 2.0 * k - 1.0)
 }
 
 /// Runs `query` `repeat` times: its last answer, and the median time of one run.
@@ -377,13 +369,12 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
         },
         ..CollideOptions::default()
     };
-    let cells = f64::from(a.info().triangles) * f64::from(b.info().triangles);
     let columns = csv_columns(&["/colliding", "/contacts", "/bv_test_lower_bound"]);
     let repeat = args.inputs.repeat;
     run_query(&args.inputs, &columns, |pa, pb, context| {
         let (r, seconds) = timed(repeat, || collide_files(&a, pa, &b, pb, &options, context))?;
         // (A first-contact query finds one contact, not all: no bound applies.)
-        let bound = bv_test_lower_bound(cells, r.pairs.len()).filter(|_| !args.first);
+        let bound = obbtree::experiment::lower_bound(&a, &b, r.pairs.len()).filter(|_| !args.first);
         let mut value = json!({
             "colliding": r.colliding,
             "contacts": r.pairs.len(),

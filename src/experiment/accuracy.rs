@@ -171,8 +171,8 @@ fn tree_choices() -> Vec<TreeChoice> {
 enum Ask {
     /// `--rel-err r` (0: exact).
     RelErr(f64),
-    /// `--tolerance (1 + t) d*`: is the distance below a bound a share `t` above it? The
-    /// witness's distance is the answer measured.
+    /// `--tolerance (1 + t)·d*`: is the distance below a bound a share `t` above it? The
+    /// witness's distance is the answer measured. Spelt `--tolerance 1.1d` for `t` = 0.1.
     Tolerance(f64),
 }
 
@@ -181,7 +181,7 @@ impl Ask {
         match self {
             Ask::RelErr(0.0) => "exact".into(),
             Ask::RelErr(r) => format!("--rel-err {r}"),
-            Ask::Tolerance(t) => format!("--tolerance (1 + {t}) d"),
+            Ask::Tolerance(t) => format!("--tolerance {}d", 1.0 + t),
         }
     }
 }

@@ -69,6 +69,15 @@ pub enum ExperimentError {
     /// A tree could not be built.
     #[error(transparent)]
     Build(#[from] BuildError),
+    /// A scene's tree could not be built.
+    #[error("scene {scene}: {source}")]
+    Scene {
+        /// The scene's name (a mesh's file name).
+        scene: String,
+        /// Why.
+        #[source]
+        source: BuildError,
+    },
     /// A query failed.
     #[error(transparent)]
     Query(#[from] QueryError),
@@ -112,7 +121,7 @@ pub struct Point {
     /// Mean separated triangle pairs (S).
     pub separated: f64,
     /// Mean of the least number of volume tests that can find each query's contacts
-    /// (§2.6.3: `2 log2(n_a n_b / k) + 2k − 1` for `k > 0` contacts, 0 without contacts).
+    /// ([`lower_bound`]; a query without contacts counts 0).
     pub lower_bound: f64,
     /// Median time of one query, seconds.
     pub seconds: f64,
@@ -174,6 +183,8 @@ pub struct Outcome {
     pub name: &'static str,
     /// What the points' `x` is, with its unit.
     pub x_name: &'static str,
+    /// The CSV column of `x` (`offset`, `gap`, `triangles`).
+    pub x_column: &'static str,
     /// Every point, volume type by volume type, each in order of x.
     pub points: Vec<Point>,
     /// Lines fitted on log-log axes.
@@ -293,20 +304,16 @@ fn measure(jobs: &[Job<'_>], progress: Option<&Progress>) -> Result<Vec<Point>, 
         })
         .collect();
     let mut sums = vec![(Stats::default(), 0.0f64, Vec::new()); jobs.len()];
-    let cells: Vec<f64> = jobs
-        .iter()
-        .map(|job| f64::from(job.a.info().triangles) * f64::from(job.b.info().triangles))
-        .collect();
     for result in results {
         let (j, stats, contacts, seconds) = result?;
-        let (Some((sum, bound, times)), Some(&cells)) = (sums.get_mut(j), cells.get(j)) else {
+        let (Some((sum, bound, times)), Some(job)) = (sums.get_mut(j), jobs.get(j)) else {
             continue;
         };
         sum.bv_disjoint += stats.bv_disjoint;
         sum.bv_overlap += stats.bv_overlap;
         sum.tri_separated += stats.tri_separated;
         sum.tri_contact += stats.tri_contact;
-        *bound += lower_bound(cells, contacts);
+        *bound += lower_bound(job.a, job.b, contacts).unwrap_or(0.0);
         times.push(seconds);
     }
     Ok(jobs
@@ -331,14 +338,19 @@ fn measure(jobs: &[Job<'_>], progress: Option<&Progress>) -> Result<Vec<Point>, 
         .collect())
 }
 
-/// The least number of volume tests that can locate `contacts` contacts among `cells`
-/// triangle pairs (§2.6.3), 0 without contacts.
-pub fn lower_bound(cells: f64, contacts: usize) -> f64 {
-    if contacts == 0 {
-        return 0.0;
+/// The least number of volume tests that can locate `contacts` contacting triangle pairs
+/// between two trees (§2.6.3: ideal volumes, balanced binary trees, the contacts in one
+/// block of the n_a · n_b pairs): `2 log2(n_a n_b / k) + 2k − 1`. `None` without
+/// contacts, or when a leaf holds more than one triangle (the bound counts single-triangle
+/// leaves).
+pub fn lower_bound(a: &ObbtFile, b: &ObbtFile, contacts: usize) -> Option<f64> {
+    let single = |f: &ObbtFile| f.info().stats.shape.max_leaf_faces == 1;
+    if contacts == 0 || !single(a) || !single(b) {
+        return None;
     }
+    let cells = f64::from(a.info().triangles) * f64::from(b.info().triangles);
     let k = contacts as f64;
-    2.0 * (cells / k).log2() + 2.0 * k - 1.0
+    Some(2.0 * (cells / k).log2() + 2.0 * k - 1.0)
 }
 
 /// The points of one volume type with the default setup, in order of x.
@@ -369,9 +381,15 @@ pub fn median_time<T, E>(
     Ok((answer, median(times).unwrap_or(0.0)))
 }
 
+/// The median: the middle value, or the mean of the two middle ones.
 fn median(mut values: Vec<f64>) -> Option<f64> {
     values.sort_by(f64::total_cmp);
-    values.get(values.len() / 2).copied()
+    let n = values.len();
+    let upper = *values.get(n / 2)?;
+    if n % 2 == 1 {
+        return Some(upper);
+    }
+    Some((values.get(n / 2 - 1).copied().unwrap_or(upper) + upper) / 2.0)
 }
 
 #[cfg(test)]

@@ -75,6 +75,7 @@ pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome
     Ok(Outcome {
         name: "proximity",
         x_name: "gap between the spheres",
+        x_column: "gap",
         points,
         fits,
         comparisons,
@@ -89,7 +90,8 @@ pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome
 const RAMP: (f64, f64) = (0.4, 0.9);
 
 /// The line through the ramp of one volume type's points (log10 of volume tests against
-/// log10 of the gap): the points between the two ledges (see [`RAMP`]).
+/// log10 of the gap): the points between the two ledges, from 40% to 90% of the way in
+/// log10 volume tests from the right ledge to the left one.
 pub fn ramp_fit(points: &[Point], bv: BvKind) -> Option<Fit> {
     let logs = points.iter().map(|p| p.bv_tests().log10());
     let (least, most) = logs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {

@@ -68,6 +68,7 @@ pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome
     Ok(Outcome {
         name: "sliding",
         x_name: "x (offset of the small sphere)",
+        x_column: "offset",
         points,
         fits: Vec::new(),
         comparisons,

@@ -88,6 +88,7 @@ pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome
     Ok(Outcome {
         name: "transverse",
         x_name: "triangles per sphere",
+        x_column: "triangles",
         points,
         fits,
         comparisons,

@@ -9,7 +9,7 @@ mod shapes;
 
 pub use poses::{pose_line, random_poses, sweep, Axis, PosePair, Sweep, SweepRotation, MAX_POSES};
 pub use rng::Rng;
-pub use shapes::{cuboid, lat_long_sphere, plate};
+pub use shapes::{cuboid, lat_long_sphere, plate, MAX_GENERATED_TRIANGLES};
 
 use crate::mesh::MeshError;
 
@@ -37,17 +37,16 @@ pub enum GenerateError {
         /// The least count.
         least: u32,
     },
-    /// The shape would have more triangles than a mesh may hold.
+    /// The shape would have more triangles than [`MAX_GENERATED_TRIANGLES`].
     #[error(
-        "the shape would have {count} triangles; a mesh holds at most {}",
-        crate::mesh::MAX_TRIANGLES
+        "the shape would have {count} triangles; at most {MAX_GENERATED_TRIANGLES} are generated"
     )]
     TooManyTriangles {
         /// The triangles asked for.
         count: u64,
     },
     /// More poses than [`MAX_POSES`].
-    #[error("{count} poses asked for; at most {MAX_POSES} are made at once")]
+    #[error("{count:.3e} poses asked for; at most {MAX_POSES} are made at once")]
     TooManyPoses {
         /// The poses asked for.
         count: f64,

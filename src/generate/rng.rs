@@ -14,9 +14,16 @@ use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 pub struct Rng(u64);
 
 impl Rng {
-    /// A generator from a seed (any value, 0 included: the state is made odd, never 0).
+    /// A generator from a seed (any value). The seed is spread by the golden ratio and made
+    /// odd; seed 0, which that would leave as state 1 (whose first numbers are all near 0),
+    /// starts from the golden ratio's bits instead.
     pub fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+        let spread = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        Rng(if spread == 0 {
+            0x9e37_79b9_7f4a_7c15 ^ 0xa5a5_a5a5_a5a5_a5a5
+        } else {
+            spread
+        } | 1)
     }
 
     /// The next 64 random bits.
@@ -107,6 +114,13 @@ mod tests {
             (mean_square.add_scalar(-1.0 / 3.0)).abs().max() < 0.02,
             "{mean_square:?}"
         );
+    }
+
+    #[test]
+    fn seed_zero_starts_as_well_mixed_as_any_other() {
+        let first = Rng::new(0).unit();
+        assert!((0.001..0.999).contains(&first), "{first}");
+        assert_ne!(Rng::new(0).next_u64(), Rng::new(1).next_u64());
     }
 
     #[test]

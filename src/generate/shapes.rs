@@ -2,7 +2,7 @@
 //! tessellated plates, and boxes.
 
 use super::GenerateError;
-use crate::mesh::{TriMesh, MAX_TRIANGLES};
+use crate::mesh::TriMesh;
 use std::f64::consts::{PI, TAU};
 
 /// A latitude/longitude sphere of `radius` about the origin: `stacks` bands from pole to
@@ -89,6 +89,19 @@ pub fn cuboid(half: [f64; 3], center: [f64; 3]) -> Result<TriMesh, GenerateError
             });
         }
     }
+    for (name, (c, h)) in ["centre x", "centre y", "centre z"]
+        .into_iter()
+        .zip(center.into_iter().zip(half))
+    {
+        // Both faces of the box must be finite too.
+        if !(c.is_finite() && (c - h).is_finite() && (c + h).is_finite()) {
+            return Err(GenerateError::Parameter {
+                name,
+                value: c,
+                expected: "finite, with the box's faces finite too",
+            });
+        }
+    }
     let corners: Vec<[f64; 3]> = (0..8u32)
         .map(|i| {
             let mut p = center;
@@ -136,8 +149,12 @@ fn at_least(name: &'static str, count: u32, least: u32) -> Result<(), GenerateEr
     }
 }
 
+/// The most triangles a generated shape has: 2^24, an OBJ of about 1.5 GB, held in memory
+/// while it is written (the loaders' cap, 2^28, would take some 25 GB).
+pub const MAX_GENERATED_TRIANGLES: u64 = 1 << 24;
+
 fn triangle_count(count: u64) -> Result<(), GenerateError> {
-    if count <= MAX_TRIANGLES as u64 {
+    if count <= MAX_GENERATED_TRIANGLES {
         Ok(())
     } else {
         Err(GenerateError::TooManyTriangles { count })
@@ -209,5 +226,11 @@ mod tests {
         assert!(plate([1.0, -1.0], [2, 2]).is_err());
         assert!(plate([1.0, 1.0], [0, 2]).is_err());
         assert!(cuboid([1.0, f64::INFINITY, 1.0], [0.0; 3]).is_err());
+        assert!(cuboid([1.0; 3], [f64::NAN, 0.0, 0.0]).is_err());
+        assert!(cuboid([1e308, 1.0, 1.0], [1e308, 0.0, 0.0]).is_err());
+        assert!(matches!(
+            plate([1.0, 1.0], [5000, 5000]),
+            Err(GenerateError::TooManyTriangles { .. })
+        ));
     }
 }
