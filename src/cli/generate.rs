@@ -246,7 +246,7 @@ pub fn poses(args: &PosesArgs) -> Result<(), Failure> {
                 text.push('\n');
             }
             write(output, text.as_bytes())?;
-            eprintln!("wrote {}: {} poses", output.display(), batch.len());
+            out!("wrote {}: {} poses", output.display(), batch.len())?;
         }
         None => {
             for pair in &batch {

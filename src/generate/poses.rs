@@ -117,6 +117,13 @@ pub fn sweep(s: &Sweep) -> Result<Vec<PosePair>, GenerateError> {
 /// `count` poses of B: a uniformly random rotation and a translation uniform in the ball
 /// of `radius` about A's origin, drawn in order from `seed`. A is at the identity.
 pub fn random_poses(count: u64, radius: f64, seed: u64) -> Result<Vec<PosePair>, GenerateError> {
+    if count == 0 {
+        return Err(GenerateError::Count {
+            name: "count",
+            count: 0,
+            least: 1,
+        });
+    }
     if count > MAX_POSES {
         return Err(GenerateError::TooManyPoses {
             count: count as f64,
@@ -274,5 +281,6 @@ mod tests {
         ));
         assert!(random_poses(MAX_POSES + 1, 1.0, 0).is_err());
         assert!(random_poses(1, -1.0, 0).is_err());
+        assert!(random_poses(0, 1.0, 0).is_err());
     }
 }
