@@ -263,20 +263,7 @@ fn generators_replay_from_their_seed_and_refuse_bad_requests_in_one_line() {
         "poses", "random", "--count", "20", "--radius", "2", "--seed", "11",
     ]);
     assert_eq!(stdout.as_bytes(), std::fs::read(&a).unwrap());
-    assert_bad_input(
-        &obbtree(&[
-            "poses",
-            "random",
-            "--count",
-            "3",
-            "--radius",
-            "1",
-            "-o",
-            path(&a),
-        ]),
-        "refusing to replace",
-    );
-    run(&[
+    let three = [
         "poses",
         "random",
         "--count",
@@ -285,8 +272,9 @@ fn generators_replay_from_their_seed_and_refuse_bad_requests_in_one_line() {
         "1",
         "-o",
         path(&a),
-        "--force",
-    ]);
+    ];
+    assert_bad_input(&obbtree(&three), "refusing to replace");
+    run(&[&three[..], &["--force"]].concat());
     assert_eq!(std::fs::read_to_string(&a).unwrap().lines().count(), 3);
     let mesh = dir.join("m.obj");
     assert_bad_input(

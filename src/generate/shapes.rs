@@ -55,7 +55,10 @@ pub fn plate(size: [f64; 2], cells: [u32; 2]) -> Result<TriMesh, GenerateError> 
     at_least("cells along y", cells[1], 1)?;
     let [nx, ny] = cells;
     triangle_count(2 * u64::from(nx) * u64::from(ny))?;
-    let coordinate = |k: u32, n: u32, size: f64| size * (f64::from(k) / f64::from(n) - 0.5);
+    // Cell `k` of `n` starts at (k − n/2) cells from the centre: exact for whole-number
+    // cell sizes, so a plate of n cells of size 1 has integer and half-integer corners.
+    let coordinate =
+        |k: u32, n: u32, size: f64| (f64::from(k) - f64::from(n) / 2.0) * (size / f64::from(n));
     let mut vertices = Vec::new();
     for y in 0..=ny {
         for x in 0..=nx {

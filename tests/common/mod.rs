@@ -30,21 +30,14 @@ pub fn cuboid(half: [f64; 3], center: [f64; 3]) -> TriMesh {
 
 /// A flat `n x n` grid of unit squares in the plane z = 0, `2 n^2` triangles.
 pub fn grid(n: u32) -> TriMesh {
-    let mut vertices = Vec::new();
-    for y in 0..=n {
-        for x in 0..=n {
-            vertices.push([f64::from(x), f64::from(y), 0.0]);
-        }
-    }
-    let id = |x: u32, y: u32| y * (n + 1) + x;
-    let mut faces = Vec::new();
-    for y in 0..n {
-        for x in 0..n {
-            faces.push([id(x, y), id(x + 1, y), id(x + 1, y + 1)]);
-            faces.push([id(x, y), id(x + 1, y + 1), id(x, y + 1)]);
-        }
-    }
-    TriMesh::new(vertices, faces).expect("valid grid")
+    // The library's plate of unit cells, moved from centred to a corner at the origin.
+    let plate = obbtree::generate::plate([f64::from(n); 2], [n, n]).expect("valid grid");
+    let half = f64::from(n) / 2.0;
+    let vertices = plate
+        .vertices()
+        .iter()
+        .map(|&[x, y, z]| [x + half, y + half, z]);
+    TriMesh::new(vertices.collect(), plate.faces().to_vec()).expect("valid grid")
 }
 
 /// `mesh` as OBJ text: `v` lines (shortest decimals that read back exactly) and 1-based
