@@ -34,8 +34,8 @@ pub struct QueryInputs {
     pub json: bool,
     /// Print CSV: a header, then one row per pose with the answer, the work (D, I, S, K as
     /// in the dissertation, bv_tests = D + I, tri_tests = S + K; for all-pairs collision
-    /// also the least number of box tests that can find its contacts, §2.6.3) and the
-    /// time.
+    /// between trees of one triangle per leaf also the least number of volume tests that
+    /// can find its contacts, §2.6.3, empty without contacts) and the time.
     #[arg(long)]
     pub csv: bool,
     /// Run each query K times and report the median time (the answer is the same each
