@@ -380,19 +380,23 @@ fn write_fits(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
     Ok(path)
 }
 
+/// The palette index of a volume type's series (its place in `BvKind::ALL`).
+fn colour_of(bv: BvKind) -> usize {
+    BvKind::ALL.iter().position(|&k| k == bv).unwrap_or(0)
+}
+
 /// One series per volume type of `value` against x.
 fn per_kind(outcome: &Outcome, value: impl Fn(&Point) -> Option<f64>) -> Vec<Series> {
     BvKind::ALL
         .into_iter()
-        .enumerate()
-        .map(|(colour, bv)| Series {
+        .map(|bv| Series {
             name: bv.name().to_uppercase(),
+            colour: colour_of(bv),
             points: of_kind(&outcome.points, bv)
                 .iter()
                 .filter_map(|p| Some((p.x, value(p)?)))
                 .collect(),
             line: false,
-            colour,
             labels: Vec::new(),
         })
         .collect()
@@ -414,7 +418,7 @@ fn fitted(outcome: &Outcome, measure: &str) -> Vec<Series> {
                 ),
                 points: vec![at(f.from), at(f.to)],
                 line: true,
-                colour: BvKind::ALL.iter().position(|&k| k == f.bv).unwrap_or(0),
+                colour: colour_of(f.bv),
                 labels: Vec::new(),
             }
         })
@@ -441,7 +445,7 @@ fn thickness(outcome: &Outcome) -> Vec<Series> {
                 })
                 .collect(),
             line: false,
-            colour: BvKind::ALL.iter().position(|k| k == bv).unwrap_or(0),
+            colour: colour_of(*bv),
             labels: Vec::new(),
         })
         .collect();
@@ -484,17 +488,13 @@ fn charts(outcome: &Outcome) -> Vec<(&'static str, Chart<'static>)> {
                 colour: 0,
                 labels: Vec::new(),
             }];
-            // The intersection curve's length times the least-squares factor.
-            let (cl, ll) = obb.iter().fold((0.0, 0.0), |(cl, ll), p| {
-                let l = experiment::sliding::intersection_length(p.x);
-                (cl + p.contacts * l, ll + l * l)
-            });
-            if ll > 0.0 {
+            // The intersection curve's length times the contacts per unit length.
+            if let Some(k) = experiment::sliding::contacts_per_length(&outcome.points) {
                 contacts.push(Series {
-                    name: format!("{:.0} x length of the intersection curve", cl / ll),
+                    name: format!("{k:.0} x length of the intersection curve"),
                     points: obb
                         .iter()
-                        .map(|p| (p.x, cl / ll * experiment::sliding::intersection_length(p.x)))
+                        .map(|p| (p.x, k * experiment::sliding::intersection_length(p.x)))
                         .collect(),
                     line: true,
                     colour: 3,

@@ -155,9 +155,10 @@ pub enum RotationArg {
     Fresh,
 }
 
-/// Three numbers from a `num_args = 3` flag (clap gives exactly that many).
-fn three(values: &[f64]) -> [f64; 3] {
-    std::array::from_fn(|k| values.get(k).copied().unwrap_or(f64::NAN))
+/// The `N` values of a `num_args = N` flag (clap gives exactly that many; `missing`
+/// fills in otherwise, and the shape refuses it).
+fn values<const N: usize, T: Copy>(given: &[T], missing: T) -> [T; N] {
+    std::array::from_fn(|k| given.get(k).copied().unwrap_or(missing))
 }
 
 pub fn mesh(args: &MeshArgs) -> Result<(), Failure> {
@@ -184,12 +185,10 @@ pub fn mesh(args: &MeshArgs) -> Result<(), Failure> {
             slices,
             ..
         } => lat_long_sphere(*radius, *stacks, *slices)?,
-        ShapeCommand::Plate { size, cells, .. } => {
-            let size = [0, 1].map(|k| size.get(k).copied().unwrap_or(f64::NAN));
-            let cells = [0, 1].map(|k| cells.get(k).copied().unwrap_or(0));
-            plate(size, cells)?
+        ShapeCommand::Plate { size, cells, .. } => plate(values(size, f64::NAN), values(cells, 0))?,
+        ShapeCommand::Box { half, center, .. } => {
+            cuboid(values(half, f64::NAN), values(center, f64::NAN))?
         }
-        ShapeCommand::Box { half, center, .. } => cuboid(three(half), three(center))?,
     };
     write(output, mesh.to_obj().as_bytes())?;
     summary(output, &mesh)

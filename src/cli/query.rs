@@ -7,6 +7,7 @@ use super::print::{self, out};
 use super::{number, with_threads, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
+use obbtree::experiment::median_time;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
     collide_files, distance_files, span_files, within_tolerance_files, BoxTest, CollideOptions,
@@ -219,17 +220,9 @@ fn stats_json(s: &Stats) -> Value {
         "tri_separated": s.tri_separated,
         "tri_contact": s.tri_contact,
         "nodes_visited": s.nodes_visited,
-        "bv_tests": s.bv_disjoint + s.bv_overlap,
-        "tri_tests": s.tri_separated + s.tri_contact,
+        "bv_tests": s.bv_tests(),
+        "tri_tests": s.tri_tests(),
     })
-}
-
-/// Runs `query` `repeat` times: its last answer, and the median time of one run.
-fn timed<T>(
-    repeat: u32,
-    query: impl FnMut() -> Result<T, obbtree::query::QueryError>,
-) -> Result<(T, f64), Failure> {
-    Ok(obbtree::experiment::median_time(repeat, query)?)
 }
 
 fn stats_text(s: &Stats) -> String {
@@ -372,7 +365,8 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
     let columns = csv_columns(&["/colliding", "/contacts", "/bv_test_lower_bound"]);
     let repeat = args.inputs.repeat;
     run_query(&args.inputs, &columns, |pa, pb, context| {
-        let (r, seconds) = timed(repeat, || collide_files(&a, pa, &b, pb, &options, context))?;
+        let (r, seconds) =
+            median_time(repeat, || collide_files(&a, pa, &b, pb, &options, context))?;
         // (A first-contact query finds one contact, not all: no bound applies.)
         let bound = obbtree::experiment::lower_bound(&a, &b, r.pairs.len()).filter(|_| !args.first);
         let mut value = json!({
@@ -431,7 +425,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
     let repeat = args.inputs.repeat;
     run_query(&args.inputs, &columns, |pa, pb, context| {
         if let Some(t) = args.tolerance {
-            let (r, seconds) = timed(repeat, || {
+            let (r, seconds) = median_time(repeat, || {
                 within_tolerance_files(&a, pa, &b, pb, t, rule, context)
             })?;
             let w = r.witness.as_ref();
@@ -461,7 +455,8 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
             };
             return Ok((value, text));
         }
-        let (r, seconds) = timed(repeat, || distance_files(&a, pa, &b, pb, &options, context))?;
+        let (r, seconds) =
+            median_time(repeat, || distance_files(&a, pa, &b, pb, &options, context))?;
         let value = witness_json(
             "distance",
             r.distance,
@@ -489,7 +484,7 @@ pub fn span(args: &SpanArgs) -> Result<(), Failure> {
     let columns = csv_columns(&["/span", "/tri_a", "/tri_b"]);
     let repeat = args.inputs.repeat;
     run_query(&args.inputs, &columns, |pa, pb, context| {
-        let (r, seconds) = timed(repeat, || span_files(&a, pa, &b, pb, rule, context))?;
+        let (r, seconds) = median_time(repeat, || span_files(&a, pa, &b, pb, rule, context))?;
         let value = witness_json(
             "span",
             r.span,

@@ -107,6 +107,22 @@ pub struct Trade {
     pub pareto: bool,
 }
 
+impl Trade {
+    /// A trade with nothing measured yet.
+    fn new(scene: &str, query: &'static str, choice: String) -> Trade {
+        Trade {
+            scene: scene.into(),
+            query,
+            choice,
+            seconds: 0.0,
+            error_mean: 0.0,
+            error_max: 0.0,
+            bv_tests: 0.0,
+            pareto: false,
+        }
+    }
+}
+
 /// A tree choice: storage precision, fit and leaf size.
 #[derive(Clone, Copy, Debug)]
 struct TreeChoice {
@@ -254,16 +270,8 @@ fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentErr
             &[Ask::RelErr(0.0)]
         };
         for &ask in asks {
-            let mut trade = Trade {
-                scene: scene.name.clone(),
-                query: "distance",
-                choice: [choice.flags(), vec![ask.flag()]].concat().join(", "),
-                seconds: 0.0,
-                error_mean: 0.0,
-                error_max: 0.0,
-                bv_tests: 0.0,
-                pareto: false,
-            };
+            let choice = [choice.flags(), vec![ask.flag()]].concat().join(", ");
+            let mut trade = Trade::new(&scene.name, "distance", choice);
             for ([pa, pb], &d) in scene.apart.iter().zip(&distances) {
                 let ((found, tests), seconds) =
                     median_time(repeat, || -> Result<_, QueryError> {
@@ -274,7 +282,7 @@ fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentErr
                                     ..DistanceOptions::default()
                                 };
                                 let r = distance_files(&a, pa, &b, pb, &options, &mut context)?;
-                                Ok((r.distance, r.stats.bv_disjoint + r.stats.bv_overlap))
+                                Ok((r.distance, r.stats.bv_tests()))
                             }
                             Ask::Tolerance(t) => {
                                 let rule = DescentRule::default();
@@ -288,7 +296,7 @@ fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentErr
                                     &mut context,
                                 )?;
                                 let found = r.witness.map_or(f64::INFINITY, |w| w.distance);
-                                Ok((found, r.stats.bv_disjoint + r.stats.bv_overlap))
+                                Ok((found, r.stats.bv_tests()))
                             }
                         }
                     })?;
@@ -302,21 +310,14 @@ fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentErr
             finish(&mut trade, scene.apart.len());
             out.push(trade);
         }
-        let mut trade = Trade {
-            scene: scene.name.clone(),
-            query: "collision",
-            choice: choice.flags().join(", "),
-            seconds: 0.0,
-            error_mean: 0.0,
-            error_max: 0.0,
-            bv_tests: 0.0,
-            pareto: false,
-        };
+        let mut trade = Trade::new(&scene.name, "collision", choice.flags().join(", "));
         for ([pa, pb], expected) in scene.crossing.iter().zip(&contacts) {
             let ((found, tests), seconds) = median_time(repeat, || -> Result<_, QueryError> {
                 let r = collide_files(&a, pa, &b, pb, &CollideOptions::default(), &mut context)?;
-                let tests = r.stats.bv_disjoint + r.stats.bv_overlap;
-                Ok((r.pairs.into_iter().collect::<BTreeSet<_>>(), tests))
+                Ok((
+                    r.pairs.into_iter().collect::<BTreeSet<_>>(),
+                    r.stats.bv_tests(),
+                ))
             })?;
             let differing = found.symmetric_difference(expected).count();
             let error = differing as f64 / expected.len().max(1) as f64;

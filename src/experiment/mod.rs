@@ -148,11 +148,6 @@ impl Point {
     pub fn tri_tests(&self) -> f64 {
         self.separated + self.contacts
     }
-
-    /// D − I + 2S + 2K: 1 for every query of a binary tree, so 1 for their mean too.
-    pub fn bvtt_identity(&self) -> f64 {
-        self.disjoint - self.overlap + 2.0 * self.separated + 2.0 * self.contacts
-    }
 }
 
 /// A figure of the dissertation beside the one measured.

@@ -87,6 +87,20 @@ pub fn intersection_length(x: f64) -> f64 {
     std::f64::consts::TAU * (1.0 - d * d).max(0.0).sqrt()
 }
 
+/// Contacts per unit length of the intersection curve: the least-squares factor `k` of
+/// contacts = k · [`intersection_length`] over the OBB points where the spheres touch.
+/// `None` without such points.
+pub fn contacts_per_length(points: &[Point]) -> Option<f64> {
+    let touching = of_kind(points, BvKind::Obb)
+        .into_iter()
+        .filter(|p| p.contacts > 0.0);
+    let (cl, ll) = touching.fold((0.0, 0.0), |(cl, ll), p| {
+        let l = intersection_length(p.x);
+        (cl + p.contacts * l, ll + l * l)
+    });
+    (ll > 0.0).then(|| cl / ll)
+}
+
 fn compare(points: &[Point]) -> Vec<Comparison> {
     let obb = of_kind(points, BvKind::Obb);
     let others = [
@@ -122,20 +136,10 @@ fn compare(points: &[Point]) -> Vec<Comparison> {
             format!("{lo:.1} to {:.1} ({contacts:.0} contacts)", lo + 0.1)
         }),
     ));
-    // Contacts per unit length of the intersection curve: the least-squares factor k of
-    // contacts = k * length.
-    let (cl, ll) = touching.iter().fold((0.0, 0.0), |(cl, ll), p| {
-        let l = intersection_length(p.x);
-        (cl + p.contacts * l, ll + l * l)
-    });
     out.push(Comparison::new(
         "contacts per unit length of intersection curve",
         "about 70",
-        if ll > 0.0 {
-            format!("{:.0}", cl / ll)
-        } else {
-            "-".into()
-        },
+        contacts_per_length(points).map_or("-".into(), |k| format!("{k:.0}")),
     ));
     for (name, series) in &others {
         let dissertation = if name.starts_with("AABB") {

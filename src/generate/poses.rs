@@ -97,8 +97,7 @@ pub fn sweep(s: &Sweep) -> Result<Vec<PosePair>, GenerateError> {
         return Err(GenerateError::TooManyPoses { count: steps + 1.0 });
     }
     let count = steps as u64 + 1;
-    let mut rng = Rng::new(s.seed);
-    let fixed = rng.uniform_rotation();
+    let fixed = Rng::new(s.seed).uniform_rotation();
     let mut rng = Rng::new(s.seed);
     let poses = (0..count)
         .map(|i| {

@@ -24,6 +24,16 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// Bounding-volume pair tests, `D + I`.
+    pub fn bv_tests(&self) -> u64 {
+        self.bv_disjoint + self.bv_overlap
+    }
+
+    /// Triangle pair tests, `S + K`.
+    pub fn tri_tests(&self) -> u64 {
+        self.tri_separated + self.tri_contact
+    }
+
     /// `D − I + 2S + 2K`, which is 1 for a complete traversal of binary single-face trees.
     pub fn identity_value(&self) -> i128 {
         i128::from(self.bv_disjoint) - i128::from(self.bv_overlap)

@@ -580,7 +580,7 @@ impl Scene {
         if let Some(work) = s.narrow.of(&job.effect) {
             work.add(&EffectWork {
                 queries: 1,
-                box_tests: outcome.stats.bv_disjoint + outcome.stats.bv_overlap,
+                box_tests: outcome.stats.bv_tests(),
                 triangle_tests: outcome.stats.tri_separated + outcome.stats.tri_contact,
                 seconds: outcome.seconds,
             });
