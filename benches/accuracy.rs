@@ -32,9 +32,7 @@ use obbtree::bv::pair::SAT_GUARD;
 use obbtree::fit::FitMethod;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
-use obbtree::query::{
-    collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
-};
+use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
 use obbtree::real::Precision;
 use parry3d::math::Pose as PPose;
 use parry_support::{parry_mesh, parry_pose};
@@ -204,7 +202,6 @@ fn distance_options(config: &Config) -> DistanceOptions {
 
 fn accuracy(c: &mut Criterion) {
     let scenes: Vec<Scene> = [Some(spheres()), bunny()].into_iter().flatten().collect();
-    let mut context = QueryContext::new();
     for scene in &scenes {
         let built: Vec<(Config, ObbtFile, ObbtFile)> = CONFIGS
             .iter()
@@ -228,35 +225,25 @@ fn accuracy(c: &mut Criterion) {
             "config", "contacts", "gained", "lost", "distance", "vs baseline", "D+I"
         );
         for (config, a, b) in &built {
-            let hit = collide_files(
-                a,
-                &id,
-                b,
-                &scene.collide_pose,
-                &collide_options(config),
-                &mut context,
-            )
-            .expect("query");
-            let d = distance_files(
-                a,
-                &id,
-                b,
-                &scene.distance_pose,
-                &distance_options(config),
-                &mut context,
-            )
-            .expect("query");
+            let mut pair = PairQuery::new(a, b).expect("one volume type");
+            let hit = pair
+                .collide(&id, &scene.collide_pose, &collide_options(config))
+                .expect("query");
+            let d = pair
+                .distance(&id, &scene.distance_pose, &distance_options(config))
+                .expect("query")
+                .distance();
             let pairs: BTreeSet<(u32, u32)> = hit.pairs.iter().copied().collect();
-            let (base_pairs, base_d) = baseline.get_or_insert_with(|| (pairs.clone(), d.distance));
+            let (base_pairs, base_d) = baseline.get_or_insert_with(|| (pairs.clone(), d));
             println!(
                 "{:>14} {:>9} {:>7} {:>7} {:>16.10e} {:>12.2e} {:>9}",
                 config.name,
                 pairs.len(),
                 pairs.difference(base_pairs).count(),
                 base_pairs.difference(&pairs).count(),
-                d.distance,
-                (d.distance - *base_d) / *base_d,
-                hit.stats.bv_disjoint + hit.stats.bv_overlap,
+                d,
+                (d - *base_d) / *base_d,
+                hit.work.bv_disjoint + hit.work.bv_overlap,
             );
         }
 
@@ -273,6 +260,7 @@ fn accuracy(c: &mut Criterion) {
             );
         }
         for (config, a, b) in &built {
+            let mut pair = PairQuery::new(a, b).expect("one volume type");
             if config.rel_err == 0.0 {
                 let options = collide_options(config);
                 group.bench_with_input(
@@ -280,7 +268,7 @@ fn accuracy(c: &mut Criterion) {
                     &options,
                     |bench, options| {
                         bench.iter(|| {
-                            collide_files(a, &id, b, &scene.collide_pose, options, &mut context)
+                            pair.collide(&id, &scene.collide_pose, options)
                                 .expect("query")
                                 .pairs
                                 .len()
@@ -295,9 +283,9 @@ fn accuracy(c: &mut Criterion) {
                     &options,
                     |bench, options| {
                         bench.iter(|| {
-                            distance_files(a, &id, b, &scene.distance_pose, options, &mut context)
+                            pair.distance(&id, &scene.distance_pose, options)
                                 .expect("query")
-                                .distance
+                                .distance()
                         })
                     },
                 );
@@ -322,7 +310,8 @@ fn near_contact_table(_: &mut Criterion) {
     .expect("builds");
     let f32_file = build(&cube, &BuildOptions::default(), None).expect("builds");
     let parry_cube = parry_mesh(&cube);
-    let mut context = QueryContext::new();
+    let mut pair_f64 = PairQuery::new(&f64_file, &f64_file).expect("one volume type");
+    let mut pair_f32 = PairQuery::new(&f32_file, &f32_file).expect("one volume type");
     println!("\nnear contact, two unit cubes face to face, a slight rotation on B:");
     println!(
         "{:>8} {:>14} {:>14} {:>14}",
@@ -340,17 +329,10 @@ fn near_contact_table(_: &mut Criterion) {
             .map(|p| -(rotation * Vector3::from(*p)).x)
             .fold(f64::MIN, f64::max);
         let pose = Pose::new(rotation, Vector3::new(1.0 + reach + gap, 0.0, 0.0)).expect("pose");
-        let ours = |file: &ObbtFile, context: &mut QueryContext| {
-            distance_files(
-                file,
-                &Pose::identity(),
-                file,
-                &pose,
-                &DistanceOptions::default(),
-                context,
-            )
-            .expect("query")
-            .distance
+        let ours = |pair: &mut PairQuery<'_>| {
+            pair.distance(&Pose::identity(), &pose, &DistanceOptions::default())
+                .expect("query")
+                .distance()
         };
         let theirs = parry3d::query::distance(
             &PPose::IDENTITY,
@@ -362,8 +344,8 @@ fn near_contact_table(_: &mut Criterion) {
         .distance;
         println!(
             "{gap:>8.0e} {:>14.6e} {:>14.6e} {:>14.6e}",
-            ours(&f64_file, &mut context),
-            ours(&f32_file, &mut context),
+            ours(&mut pair_f64),
+            ours(&mut pair_f32),
             theirs
         );
     }

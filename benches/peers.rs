@@ -141,7 +141,15 @@ fn measure(pair: &mut PairQuery<'_>, pa: &Pose, pb: &Pose) -> Ours {
     pair.collide_into(pa, pb, &all, &mut buffer)
         .expect("collide");
     let contacts = buffer.pairs.len();
-    let first = pair.first_contact(pa, pb).expect("first").is_some();
+    // First contact into a buffer of its own, kept between calls as `all`'s is.
+    let first_contact = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
+    let mut first_buffer = Default::default();
+    pair.collide_into(pa, pb, &first_contact, &mut first_buffer)
+        .expect("first");
+    let first = first_buffer.colliding;
     let exact = DistanceOptions::default();
     let rel = DistanceOptions {
         rel_err: 0.01,
@@ -153,7 +161,9 @@ fn measure(pair: &mut PairQuery<'_>, pa: &Pose, pb: &Pose) -> Ours {
             .expect("collide");
     });
     let first_s = median_time(|| {
-        std::hint::black_box(pair.first_contact(pa, pb).expect("first"));
+        pair.collide_into(pa, pb, &first_contact, &mut first_buffer)
+            .expect("first");
+        std::hint::black_box(first_buffer.pairs.first().copied());
     });
     let exact_s = median_time(|| {
         std::hint::black_box(pair.distance(pa, pb, &exact).expect("distance"));
@@ -164,12 +174,12 @@ fn measure(pair: &mut PairQuery<'_>, pa: &Pose, pb: &Pose) -> Ours {
     Ours {
         contacts,
         first,
-        distance: d.distance,
+        distance: d.distance(),
         all_s,
         first_s,
         exact_s,
         rel_s,
-        tri_tests: d.stats.tri_contact + d.stats.tri_separated,
+        tri_tests: d.work.tri_contact + d.work.tri_separated,
     }
 }
 

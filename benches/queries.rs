@@ -19,9 +19,7 @@ mod common;
 mod parry_support;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use obbtree::query::{
-    collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
-};
+use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
 use parry3d::bounding_volume::BoundingVolume as _;
 use parry3d::math::Pose as PPose;
 use std::hint::black_box;
@@ -57,7 +55,7 @@ fn sliding_spheres(c: &mut Criterion) {
     let small = common::uv_sphere(0.8, 101, 200);
     let (ta, tb) = (tree(&big), tree(&small));
     let (pa, pb) = (parry_mesh(&big), parry_mesh(&small));
-    let mut context = QueryContext::new();
+    let mut pair = PairQuery::new(&ta, &tb).expect("one volume type");
     let mut group = c.benchmark_group("sliding");
     println!("\nsliding spheres, 40,000 triangles each, OBB f64:");
     println!(
@@ -71,10 +69,9 @@ fn sliding_spheres(c: &mut Criterion) {
             first_contact: true,
             ..CollideOptions::default()
         };
-        let r =
-            collide_files(&ta, &Pose::identity(), &tb, &pose, &all, &mut context).expect("query");
+        let r = pair.collide(&Pose::identity(), &pose, &all).expect("query");
         let pos12 = parry_pose(&pose);
-        let s = r.stats;
+        let s = r.work;
         println!(
             "{x:>5.1} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12}",
             r.pairs.len(),
@@ -86,7 +83,7 @@ fn sliding_spheres(c: &mut Criterion) {
         );
         group.bench_with_input(BenchmarkId::new("all", x), &pose, |bench, pose| {
             bench.iter(|| {
-                collide_files(&ta, &Pose::identity(), &tb, pose, &all, &mut context)
+                pair.collide(&Pose::identity(), pose, &all)
                     .expect("query")
                     .pairs
                     .len()
@@ -94,7 +91,7 @@ fn sliding_spheres(c: &mut Criterion) {
         });
         group.bench_with_input(BenchmarkId::new("first", x), &pose, |bench, pose| {
             bench.iter(|| {
-                collide_files(&ta, &Pose::identity(), &tb, pose, &first, &mut context)
+                pair.collide(&Pose::identity(), pose, &first)
                     .expect("query")
                     .colliding
             })
@@ -124,13 +121,14 @@ fn concentric_spheres(c: &mut Criterion) {
     let (pa, pb) = (parry_mesh(&inner), parry_mesh(&outer));
     let pose =
         Pose::new(common::rng::seeded_rotation(7), nalgebra::Vector3::zeros()).expect("rotation");
-    let mut context = QueryContext::new();
+    let mut pair = PairQuery::new(&ta, &tb).expect("one volume type");
     let exact = DistanceOptions::default();
-    let r =
-        distance_files(&ta, &Pose::identity(), &tb, &pose, &exact, &mut context).expect("query");
+    let r = pair
+        .distance(&Pose::identity(), &pose, &exact)
+        .expect("query");
     let pos12 = parry_pose(&pose);
     let parry_d = black_box(parry3d::query::distance(&PPose::IDENTITY, &pa, &pos12, &pb));
-    println!("\nconcentric spheres (1 and 1.05), 40,000 triangles each: distance {} ({:?}); parry: {parry_d:?}", r.distance, r.stats);
+    println!("\nconcentric spheres (1 and 1.05), 40,000 triangles each: distance {} ({:?}); parry: {parry_d:?}", r.distance(), r.work);
     let mut group = c.benchmark_group("concentric");
     group.sample_size(10);
     for rel in [0.0, 0.01, 0.1] {
@@ -143,9 +141,9 @@ fn concentric_spheres(c: &mut Criterion) {
             &options,
             |bench, options| {
                 bench.iter(|| {
-                    distance_files(&ta, &Pose::identity(), &tb, &pose, options, &mut context)
+                    pair.distance(&Pose::identity(), &pose, options)
                         .expect("query")
-                        .distance
+                        .distance()
                 })
             },
         );
@@ -158,7 +156,6 @@ fn concentric_spheres(c: &mut Criterion) {
 
 fn far_apart(c: &mut Criterion) {
     let cow = common::cow();
-    let mut context = QueryContext::new();
     let mut group = c.benchmark_group("far");
     println!("\ntwo cows far apart, triangle tests of exact distance / rel_err 0.01:");
     for bv in [obbtree::bv::BvKind::Obb, obbtree::bv::BvKind::Aabb] {
@@ -167,6 +164,7 @@ fn far_apart(c: &mut Criterion) {
             ..Default::default()
         };
         let file = obbtree::build::build(&cow, &options, None).expect("builds");
+        let mut pair = PairQuery::new(&file, &file).expect("one volume type");
         for offset in [1e3, 1e5, 1e6, 1e9] {
             let direction = nalgebra::Vector3::new(1.0, -1.0, 1.0).normalize();
             let pose =
@@ -177,26 +175,16 @@ fn far_apart(c: &mut Criterion) {
                 rel_err: 0.01,
                 ..DistanceOptions::default()
             };
-            let tests = |o: &DistanceOptions, context: &mut QueryContext| {
-                let s = distance_files(&file, &a, &file, &pose, o, context)
-                    .expect("query")
-                    .stats;
+            let mut tests = |o: &DistanceOptions| {
+                let s = pair.distance(&a, &pose, o).expect("query").work;
                 s.tri_separated + s.tri_contact
             };
-            println!(
-                "  {} {offset:e}: {} / {}",
-                bv.name(),
-                tests(&exact, &mut context),
-                tests(&rel, &mut context)
-            );
+            let (exact_tests, rel_tests) = (tests(&exact), tests(&rel));
+            println!("  {} {offset:e}: {exact_tests} / {rel_tests}", bv.name());
             for (name, o) in [("exact", &exact), ("rel-err-0.01", &rel)] {
                 let id = BenchmarkId::new(format!("{}-{name}", bv.name()), offset);
                 group.bench_with_input(id, o, |bench, o| {
-                    bench.iter(|| {
-                        distance_files(&file, &a, &file, &pose, o, &mut context)
-                            .expect("query")
-                            .distance
-                    })
+                    bench.iter(|| pair.distance(&a, &pose, o).expect("query").distance())
                 });
             }
         }

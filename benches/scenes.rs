@@ -276,10 +276,10 @@ fn warm_start_benchmark() {
         let started = Instant::now();
         let warm = pair.distance(&identity, pose, &options).unwrap();
         warm_times.push(started.elapsed().as_secs_f64());
-        assert_eq!(warm.distance, cold.distance);
-        previous = Some(warm.witness);
-        cold_tests += cold.stats.bv_disjoint + cold.stats.bv_overlap;
-        warm_tests += warm.stats.bv_disjoint + warm.stats.bv_overlap;
+        assert_eq!(warm.distance(), cold.distance());
+        previous = warm.warm_start;
+        cold_tests += cold.work.bv_disjoint + cold.work.bv_overlap;
+        warm_tests += warm.work.bv_disjoint + warm.work.bv_overlap;
     }
     let (cold, warm) = (median(cold_times), median(warm_times));
     println!(

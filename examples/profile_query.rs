@@ -50,8 +50,12 @@ fn main() {
         (None, "concentric") => (Pose::identity(), Pose::identity()),
         (None, _) => (Pose::identity(), common::sliding_pose(x, 5)),
     };
-    let mut buffer = Default::default();
+    let (mut buffer, mut first_buffer) = (Default::default(), Default::default());
     let all = CollideOptions::default();
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
     let exact = DistanceOptions::default();
     let rel = DistanceOptions {
         rel_err: 0.01,
@@ -61,18 +65,22 @@ fn main() {
     let mut once = |pair: &mut PairQuery<'_>| {
         let (here, there) = std::hint::black_box((&here, &there));
         match kind {
-            "first" | "culled" => pair.first_contact_stats(here, there).expect("q").1,
-            "distance" | "concentric" => pair.distance(here, there, &exact).expect("q").stats,
-            "rel" => pair.distance(here, there, &rel).expect("q").stats,
+            "first" | "culled" => {
+                pair.collide_into(here, there, &first, &mut first_buffer)
+                    .expect("q");
+                first_buffer.work
+            }
+            "distance" | "concentric" => pair.distance(here, there, &exact).expect("q").work,
+            "rel" => pair.distance(here, there, &rel).expect("q").work,
             _ => {
                 pair.collide_into(here, there, &all, &mut buffer)
                     .expect("q");
-                buffer.stats
+                buffer.work
             }
         }
     };
     if kind == "views" {
-        // The cost of typing a file's sections, which every query of a PairQuery pays.
+        // The cost of typing a file's sections, which PairQuery::new pays once per pair.
         let t0 = Instant::now();
         for _ in 0..runs {
             let f = std::hint::black_box(&a);

@@ -12,10 +12,7 @@
 use obbtree::build::{build, BuildOptions};
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
-use obbtree::query::{
-    collide_files, distance_files, span_files, CollideOptions, DescentRule, DistanceOptions, Pose,
-    QueryContext,
-};
+use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose, SpanOptions};
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -44,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         b.info().triangles
     );
 
-    // Four threads share the two maps; each keeps its own QueryContext (its traversal stack).
+    // Four threads share the two maps; each keeps its own PairQuery (its traversal stack).
     let extent = (0..3)
         .map(|k| a.info().stats.bounds_max[k] - a.info().stats.bounds_min[k])
         .fold(0.0, f64::max);
@@ -52,41 +49,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for thread in 0..4 {
             let (a, b) = (&a, &b);
             scope.spawn(move || -> Result<(), obbtree::query::QueryError> {
-                let mut context = QueryContext::new();
+                let mut pair = PairQuery::new(a, b)?;
                 let angle = 0.4 * f64::from(thread);
                 let rotation = *nalgebra::Rotation3::from_euler_angles(0.0, angle, 0.0).matrix();
                 let offset = nalgebra::Vector3::new(0.3 * extent * f64::from(thread), 0.0, 0.0);
                 let pose_b = Pose::new(rotation, offset).expect("a rotation");
-                let hit = collide_files(
-                    a,
-                    &Pose::identity(),
-                    b,
-                    &pose_b,
-                    &CollideOptions::default(),
-                    &mut context,
-                )?;
-                let gap = distance_files(
-                    a,
-                    &Pose::identity(),
-                    b,
-                    &pose_b,
-                    &DistanceOptions::default(),
-                    &mut context,
-                )?;
-                let far = span_files(
-                    a,
-                    &Pose::identity(),
-                    b,
-                    &pose_b,
-                    DescentRule::default(),
-                    &mut context,
-                )?;
+                let here = Pose::identity();
+                let hit = pair.collide(&here, &pose_b, &CollideOptions::default())?;
+                let gap = pair.distance(&here, &pose_b, &DistanceOptions::default())?;
+                let far = pair.span(&here, &pose_b, &SpanOptions::default())?;
                 println!(
                     "thread {thread}: B shifted {:.3}: {} contacts, distance {:.6}, span {:.4}",
                     offset.x,
                     hit.pairs.len(),
-                    gap.distance,
-                    far.span
+                    gap.distance(),
+                    far.span()
                 );
                 Ok(())
             });

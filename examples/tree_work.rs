@@ -72,19 +72,23 @@ fn main() {
         let near = Pose::new(turn, direction * diagonal * near).expect("a rotation");
         pair.collide_into(&here, &near, &CollideOptions::default(), &mut contacts)
             .expect("collide");
-        collide_tests += contacts.stats.bv_disjoint + contacts.stats.bv_overlap;
+        collide_tests += contacts.work.bv_disjoint + contacts.work.bv_overlap;
+        let first = CollideOptions {
+            first_contact: true,
+            ..CollideOptions::default()
+        };
         first_nodes += pair
-            .first_contact_stats(&here, &near)
+            .collide(&here, &near, &first)
             .expect("first")
-            .1
+            .work
             .nodes_visited;
         let far = [1.05, 1.2, 1.5, 3.0][(k % 4) as usize];
         let far = Pose::new(turn, direction * diagonal * far).expect("a rotation");
         let d = pair
             .distance(&here, &far, &DistanceOptions::default())
             .expect("distance");
-        distance_nodes += d.stats.nodes_visited;
-        distance_tris += d.stats.tri_separated + d.stats.tri_contact;
+        distance_nodes += d.work.nodes_visited;
+        distance_tris += d.work.tri_separated + d.work.tri_contact;
     }
     println!(
         "{name}: build {build_ms:.1} ms (1 thread); collide box tests {collide_tests}; \

@@ -22,9 +22,8 @@ use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::mesh::TriMesh;
 use obbtree::query::{
-    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions,
-    CollideResult, DescentRule, DistanceOptions, DistanceResult, Pose, QueryContext, QueryError,
-    SpanResult, ToleranceResult,
+    CollideOptions, CollideResult, DescentRule, DistanceOptions, DistanceResult, PairQuery, Pose,
+    QueryError, SpanOptions, SpanResult, ToleranceOptions, ToleranceResult,
 };
 use obbtree::real::Precision;
 use obbtree::tree::Encoding;
@@ -189,28 +188,35 @@ impl Queries {
             };
         };
         let id = Pose::identity();
-        let mut cx = QueryContext::new();
         let all = CollideOptions::default();
         let first = CollideOptions {
             first_contact: true,
             ..CollideOptions::default()
         };
         let rule = DescentRule::default();
+        let mut pair = match PairQuery::new(file, file) {
+            Ok(pair) => pair,
+            // A file whose sections cannot be viewed: every query refuses it.
+            Err(error) => {
+                return Queries {
+                    collide: Some(Err(error.clone())),
+                    first: Some(Err(error.clone())),
+                    distance: Some(Err(error.clone())),
+                    tolerance: Some(Err(error.clone())),
+                    span: Some(Err(error)),
+                }
+            }
+        };
+        let tolerance = ToleranceOptions {
+            tolerance: TOLERANCE,
+            rule,
+        };
         Queries {
-            collide: Some(collide_files(file, &id, file, &pose_b, &all, &mut cx)),
-            first: Some(collide_files(file, &id, file, &pose_b, &first, &mut cx)),
-            distance: Some(distance_files(
-                file,
-                &id,
-                file,
-                &pose_b,
-                &DistanceOptions::default(),
-                &mut cx,
-            )),
-            tolerance: Some(within_tolerance_files(
-                file, &id, file, &pose_b, TOLERANCE, rule, &mut cx,
-            )),
-            span: Some(span_files(file, &id, file, &pose_b, rule, &mut cx)),
+            collide: Some(pair.collide(&id, &pose_b, &all)),
+            first: Some(pair.collide(&id, &pose_b, &first)),
+            distance: Some(pair.distance(&id, &pose_b, &DistanceOptions::default())),
+            tolerance: Some(pair.within(&id, &pose_b, &tolerance)),
+            span: Some(pair.span(&id, &pose_b, &SpanOptions { rule })),
         }
     }
 }
@@ -245,12 +251,15 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
         })
         .sum::<f64>()
         .sqrt();
-    let mut cx = QueryContext::new();
+    let mut pair = match PairQuery::new(file, file) {
+        Ok(pair) => pair,
+        Err(error) => panic!("a verified file cannot be queried: {error}"),
+    };
     let id = Pose::identity();
     let rule = DescentRule::default();
 
     // The file against itself at the same pose: every triangle touches itself.
-    match collide_files(file, &id, file, &id, &CollideOptions::default(), &mut cx) {
+    match pair.collide(&id, &id, &CollideOptions::default()) {
         Ok(hit) => {
             assert!(
                 hit.colliding,
@@ -270,7 +279,7 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
         first_contact: true,
         ..CollideOptions::default()
     };
-    match collide_files(file, &id, file, &id, &first, &mut cx) {
+    match pair.collide(&id, &id, &first) {
         Ok(hit) => {
             assert!(hit.colliding, "first contact: no self-collision");
             assert_eq!(hit.pairs.len(), 1, "first contact returned several pairs");
@@ -278,8 +287,11 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
         }
         Err(error) => panic!("first-contact self-collision on a verified file failed: {error}"),
     }
-    match distance_files(file, &id, file, &id, &DistanceOptions::default(), &mut cx) {
+    match pair.distance(&id, &id, &DistanceOptions::default()) {
         Ok(d) => {
+            let Some(d) = d.closest else {
+                panic!("self-distance on a verified file has no closest pair");
+            };
             assert!(
                 d.distance == 0.0,
                 "self-distance is {} (triangles {} and {}), not 0",
@@ -294,20 +306,24 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
         }
         Err(error) => panic!("self-distance on a verified file failed: {error}"),
     }
-    match within_tolerance_files(file, &id, file, &id, TOLERANCE, rule, &mut cx) {
+    let tolerance = ToleranceOptions {
+        tolerance: TOLERANCE,
+        rule,
+    };
+    match pair.within(&id, &id, &tolerance) {
         Ok(w) => assert!(
-            w.closer,
+            w.closer(),
             "a verified file is not within tolerance of itself"
         ),
         Err(error) => panic!("self-tolerance on a verified file failed: {error}"),
     }
-    match span_files(file, &id, file, &id, rule, &mut cx) {
+    match pair.span(&id, &id, &SpanOptions { rule }) {
         Ok(s) => {
-            assert!(s.span >= 0.0, "self-span is {}", s.span);
+            assert!(s.span() >= 0.0, "self-span is {}", s.span());
             assert!(
-                s.span <= diagonal * (1.0 + 1e-12) + 1e-300,
+                s.span() <= diagonal * (1.0 + 1e-12) + 1e-300,
                 "self-span {} exceeds the bounds' diagonal {diagonal}",
-                s.span
+                s.span()
             );
         }
         Err(error) => panic!("self-span on a verified file failed: {error}"),
@@ -333,7 +349,11 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
             }
         }
     }
-    let distance = ok("distance", before.distance.as_ref());
+    // Without a maximum distance an answer always has its closest pair.
+    let distance = ok("distance", before.distance.as_ref()).map(|d| match d.closest {
+        Some(closest) => closest,
+        None => panic!("a posed distance on a verified file has no closest pair"),
+    });
     if let Some(d) = distance {
         assert!(d.distance >= 0.0, "posed distance is {}", d.distance);
         assert!(
@@ -360,25 +380,29 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
     }
     if let Some(w) = ok("tolerance", before.tolerance.as_ref()) {
         if let Some(witness) = &w.witness {
-            assert!(w.closer, "a tolerance witness without `closer`");
+            assert!(w.closer(), "a tolerance witness without `closer`");
             assert!(
                 witness.distance < TOLERANCE,
                 "a tolerance witness at {}",
                 witness.distance
             );
         } else {
-            assert!(!w.closer, "`closer` without a witness");
+            assert!(!w.closer(), "`closer` without a witness");
         }
         if let Some(d) = distance {
             if d.distance < TOLERANCE - slack {
                 assert!(
-                    w.closer,
+                    w.closer(),
                     "distance {} but not within {TOLERANCE}",
                     d.distance
                 );
             }
             if d.distance > TOLERANCE + slack {
-                assert!(!w.closer, "distance {} but within {TOLERANCE}", d.distance);
+                assert!(
+                    !w.closer(),
+                    "distance {} but within {TOLERANCE}",
+                    d.distance
+                );
             }
             if let Some(witness) = &w.witness {
                 assert!(
@@ -391,13 +415,17 @@ fn check_verified(file: &ObbtFile, before: &Queries) {
         }
     }
     if let Some(s) = ok("span", before.span.as_ref()) {
-        assert!(s.span >= 0.0, "posed span is {}", s.span);
-        assert!(s.tri_a < triangles && s.tri_b < triangles, "posed span ids");
+        let far = &s.farthest;
+        assert!(s.span() >= 0.0, "posed span is {}", s.span());
+        assert!(
+            far.tri_a < triangles && far.tri_b < triangles,
+            "posed span ids"
+        );
         if let Some(d) = distance {
             assert!(
-                s.span >= d.distance - slack,
+                s.span() >= d.distance - slack,
                 "the span {} is less than the distance {}",
-                s.span,
+                s.span(),
                 d.distance
             );
         }
@@ -417,7 +445,7 @@ fn check_collide_result(hit: &CollideResult, triangles: u32, complete_binary: bo
         hit.pairs.windows(2).all(|w| w[0] < w[1]),
         "{what}: pairs not sorted and distinct"
     );
-    let s = hit.stats;
+    let s = hit.work;
     assert_eq!(
         s.nodes_visited,
         s.bv_disjoint + s.bv_overlap,

@@ -24,23 +24,28 @@
 //! let cow = ObbtFile::open(&path)?;
 //! cow.verify()?;
 //!
-//! // One PairQuery per pair of models: poses per call, scratch kept between calls.
+//! // One PairQuery per pair of models: poses and options per call, scratch kept between.
 //! let mut pair = PairQuery::new(&cow, &cow)?;
 //! let here = Pose::identity();
 //! // Poses are f64 rigid motions; nalgebra's types convert (the crate re-exports the
 //! // nalgebra it uses, so the versions always match).
 //! let there = Pose::from_isometry(&Isometry3::translation(0.3, 0.0, 0.0))?;
 //!
-//! // Yes/no per frame: the first contact found, the cheapest collision answer.
-//! assert!(pair.first_contact(&here, &there)?.is_some());
+//! // Yes/no per frame: stop at the first contact, the cheapest collision answer.
+//! let first = CollideOptions { first_contact: true, ..CollideOptions::default() };
+//! assert!(pair.collide(&here, &there, &first)?.colliding);
 //! // All contacting triangle pairs (input-mesh ids), when they are needed.
 //! let contacts = pair.collide(&here, &there, &CollideOptions::default())?;
 //! assert!(contacts.pairs.len() > 1);
 //! // Separation distance with the closest points, here between copies 2 units apart.
 //! let apart = Pose::translation(2.0, 0.0, 0.0);
 //! let gap = pair.distance(&here, &apart, &DistanceOptions::default())?;
-//! assert!(gap.distance > 0.9 && gap.distance < 1.1);
-//! assert!(((gap.point_b - gap.point_a).norm() - gap.distance).abs() < 1e-9);
+//! let closest = gap.closest.expect("no maximum distance was set");
+//! assert!(closest.distance > 0.9 && closest.distance < 1.1);
+//! assert!(((closest.point_b - closest.point_a).norm() - closest.distance).abs() < 1e-9);
+//! // Only wanted up to 0.5 apart: pairs of volumes farther than that are never opened.
+//! let near = DistanceOptions { max_distance: 0.5, ..DistanceOptions::default() };
+//! assert!(pair.distance(&here, &apart, &near)?.closest.is_none());
 //! # std::fs::remove_file(&path)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -50,19 +55,20 @@
 //! - [`mesh`]: [`mesh::TriMesh`] and the OBJ / STL loaders;
 //! - [`build`]: the top-down builder and its options;
 //! - [`format`](mod@format): the `.obbt` file: open (memory-mapped), verify, write;
-//! - [`query`]: collision, distance (exact, approximate, below a limit, tolerance) and
-//!   span between two posed trees; [`query::PairQuery`] for repeated queries of a pair;
+//! - [`query`]: collision, distance (exact, approximate, up to a maximum distance),
+//!   tolerance and span between two posed trees, all through [`query::PairQuery`];
 //! - [`scene`]: many models over frames, each pair asking for its own effect;
 //! - [`generate`]: the dissertation's test shapes, pose sweeps and random poses, and the
 //!   seeded generator behind them;
-//! - [`experiment`]: the dissertation's chapter 5 experiments and the accuracy–time
-//!   trade-off, as functions returning what they measured;
+//! - `experiment` (cargo feature `experiment`, on with the default `cli`): the
+//!   dissertation's chapter 5 experiments and the accuracy–time trade-off, as functions
+//!   returning what they measured;
 //! - [`bv`], [`tree`], [`stats`], [`fit`], [`real`]: bounding volumes, the packed tree
 //!   view, tree statistics (the header's, and level by level), frame fitting and stored
 //!   precision, for tools that look inside a tree.
 //!
 //! The library never panics on data it did not make: damaged files, meshes and poses
-//! give errors (see the README's robustness section).
+//! give errors (see docs/DESIGN.md, Robustness).
 #![forbid(unsafe_op_in_unsafe_fn)]
 // The library never panics on data it did not make (files, meshes, poses): outside tests,
 // no unwrap / expect / panic, and every index or slice is checked (`get`) or, where it is in
@@ -90,6 +96,7 @@ pub use nalgebra;
 mod arr3;
 pub mod build;
 pub mod bv;
+#[cfg(feature = "experiment")]
 pub mod experiment;
 pub mod fit;
 pub mod format;

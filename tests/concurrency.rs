@@ -5,10 +5,7 @@ mod common;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::format::ObbtFile;
-use obbtree::query::{
-    collide_files, distance_files, span_files, CollideOptions, DescentRule, DistanceOptions, Pose,
-    QueryContext,
-};
+use obbtree::query::{CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, SpanOptions};
 
 /// One query's answer, reduced to comparable numbers.
 #[derive(Debug, PartialEq)]
@@ -18,25 +15,30 @@ enum Answer {
     Span(f64),
 }
 
-fn query(k: usize, file: &ObbtFile, context: &mut QueryContext) -> Answer {
+/// Query `k` of the file against itself (`pair`).
+fn query(k: usize, pair: &mut PairQuery<'_>) -> Answer {
     let pose = common::sliding_pose(0.05 * (k % 40) as f64, k as u64);
     let a = Pose::identity();
     match k % 3 {
         0 => Answer::Pairs(
-            collide_files(file, &a, file, &pose, &CollideOptions::default(), context)
+            pair.collide(&a, &pose, &CollideOptions::default())
                 .unwrap()
                 .pairs,
         ),
         1 => {
-            let d = distance_files(file, &a, file, &pose, &DistanceOptions::default(), context)
+            let d = pair
+                .distance(&a, &pose, &DistanceOptions::default())
+                .unwrap()
+                .closest
                 .unwrap();
             Answer::Distance(d.distance, d.tri_a, d.tri_b)
         }
-        _ => Answer::Span(
-            span_files(file, &a, file, &pose, DescentRule::default(), context)
-                .unwrap()
-                .span,
-        ),
+        _ => {
+            let options = SpanOptions {
+                rule: DescentRule::default(),
+            };
+            Answer::Span(pair.span(&a, &pose, &options).unwrap().span())
+        }
     }
 }
 
@@ -55,24 +57,18 @@ fn eight_threads_agree_with_one() {
     .unwrap();
     let file = ObbtFile::open(&path).unwrap();
     const PER_THREAD: usize = 1000;
-    let mut context = QueryContext::new();
-    let expected: Vec<Answer> = (0..PER_THREAD)
-        .map(|k| query(k, &file, &mut context))
-        .collect();
+    let mut pair = PairQuery::new(&file, &file).unwrap();
+    let expected: Vec<Answer> = (0..PER_THREAD).map(|k| query(k, &mut pair)).collect();
     std::thread::scope(|scope| {
         let handles: Vec<_> = (0..8)
             .map(|t| {
                 let (file, expected) = (&file, &expected);
                 scope.spawn(move || {
-                    let mut context = QueryContext::new();
+                    let mut pair = PairQuery::new(file, file).unwrap();
                     // Each thread walks the queries in its own order.
                     for i in 0..PER_THREAD {
                         let k = (i * 7 + t * 131) % PER_THREAD;
-                        assert_eq!(
-                            query(k, file, &mut context),
-                            expected[k],
-                            "thread {t}, query {k}"
-                        );
+                        assert_eq!(query(k, &mut pair), expected[k], "thread {t}, query {k}");
                     }
                 })
             })

@@ -13,14 +13,17 @@ use obbtree::query::{CollideOptions, PairQuery, Pose};
 fn first_contact_work_on_the_cow_is_pinned() {
     let cow = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
     let mut pair = PairQuery::new(&cow, &cow).expect("one volume type");
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
     let here = Pose::identity();
     let (mut nodes, mut touching) = (0u64, 0u32);
     for k in 0..30u64 {
         let scale = [0.1, 0.2, 0.3, 0.4, 0.5][(k % 5) as usize];
         let pose = common::turned_pose(k + 1, scale);
-        let (found, stats) = pair
-            .first_contact_stats(&here, &pose)
-            .expect("first contact");
+        let r = pair.collide(&here, &pose, &first).expect("first contact");
+        let (found, stats) = (r.pairs.first().copied(), r.work);
         // The answer first: a contact exactly when the all-pairs query finds one, and
         // then one of its pairs.
         let all = pair

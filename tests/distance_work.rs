@@ -6,7 +6,7 @@
 mod common;
 
 use obbtree::build::{build, BuildOptions};
-use obbtree::query::{DistanceOptions, PairQuery, Pose, Stats};
+use obbtree::query::{DistanceOptions, PairQuery, Pose, Work};
 
 /// B turned at random and moved along a random direction by 0.6 … 4 (the cow is about one
 /// unit across).
@@ -20,7 +20,7 @@ fn poses() -> Vec<Pose> {
 }
 
 /// Node pairs visited and triangle pairs measured, summed over the poses.
-fn total(stats: &[Stats]) -> (u64, u64) {
+fn total(stats: &[Work]) -> (u64, u64) {
     stats.iter().fold((0, 0), |(n, t), s| {
         (n + s.nodes_visited, t + s.tri_separated + s.tri_contact)
     })
@@ -42,20 +42,20 @@ fn distance_work_on_the_cow_is_pinned() {
         let r = pair.distance(&here, pose, &rel_options).expect("rel_err");
         // The guarantee first: within 1% of the exact distance, never below it.
         assert!(
-            r.distance >= e.distance && r.distance <= e.distance * 1.01,
+            r.distance() >= e.distance() && r.distance() <= e.distance() * 1.01,
             "pose {k}: {} against {}",
-            r.distance,
-            e.distance
+            r.distance(),
+            e.distance()
         );
         // Every pair tested is counted once, also when the traversal ends with pairs still
         // waiting because the smallest is pruned (binary trees, one face per leaf:
         // D − I + 2S + 2K = 1). A touching pair instead stops at the first zero.
-        if e.distance > 0.0 {
-            assert_eq!(e.stats.identity_value(), 1, "pose {k}: {:?}", e.stats);
-            assert_eq!(r.stats.identity_value(), 1, "pose {k}: {:?}", r.stats);
+        if e.distance() > 0.0 {
+            assert_eq!(e.work.identity_value(), 1, "pose {k}: {:?}", e.work);
+            assert_eq!(r.work.identity_value(), 1, "pose {k}: {:?}", r.work);
         }
-        exact.push(e.stats);
-        rel.push(r.stats);
+        exact.push(e.work);
+        rel.push(r.work);
     }
     // Before the best-first dives and the closest-direction bound (depth first; axis,
     // centre and centre-line bounds): exact (92,950, 8,565), rel_err 0.01 (40,052, 1,546).

@@ -12,17 +12,15 @@ use common::oracle;
 use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
-use obbtree::format::ObbtFile;
 use obbtree::query::triangle::Triangle;
 use obbtree::query::{
-    collide_files, distance_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, DistanceResult, Pose, QueryContext, Stats,
+    CollideOptions, DescentRule, DistanceOptions, DistanceResult, PairQuery, Pose, ToleranceOptions,
 };
 use obbtree::real::Precision;
 
 const OFFSETS: [f64; 5] = [1e3, 1e5, 1e6, 1e7, 1e9];
 
-fn triangle_tests(s: &Stats) -> u64 {
+fn triangle_tests(s: &obbtree::query::Work) -> u64 {
     s.tri_separated + s.tri_contact
 }
 
@@ -43,39 +41,41 @@ struct Work {
     tolerance_yes: u64,
 }
 
-fn work(file: &ObbtFile, pose: &Pose, distance: f64, context: &mut QueryContext) -> Work {
+/// The work of the distance and tolerance queries of a model against itself (`pair`).
+fn work(pair: &mut PairQuery<'_>, pose: &Pose, distance: f64) -> Work {
     let a = Pose::identity();
-    let exact = distance_files(file, &a, file, pose, &DistanceOptions::default(), context)
+    let exact = pair
+        .distance(&a, pose, &DistanceOptions::default())
         .unwrap()
-        .stats;
+        .work;
     let rel = DistanceOptions {
         rel_err: 0.01,
         ..DistanceOptions::default()
     };
-    let approximate = distance_files(file, &a, file, pose, &rel, context)
-        .unwrap()
-        .stats;
+    let approximate = pair.distance(&a, pose, &rel).unwrap().work;
     let rule = DescentRule::default();
+    let tolerance = |t| ToleranceOptions { tolerance: t, rule };
     // Just short of the distance: the answer is "no", every candidate must be ruled out.
-    let no =
-        within_tolerance_files(file, &a, file, pose, distance * 0.999_999, rule, context).unwrap();
-    assert!(!no.closer);
+    let no = pair
+        .within(&a, pose, &tolerance(distance * 0.999_999))
+        .unwrap();
+    assert!(!no.closer());
     // Just past it: "yes", found by descending towards the closest pair.
-    let yes =
-        within_tolerance_files(file, &a, file, pose, distance * 1.000_001, rule, context).unwrap();
-    assert!(yes.closer);
+    let yes = pair
+        .within(&a, pose, &tolerance(distance * 1.000_001))
+        .unwrap();
+    assert!(yes.closer());
     Work {
         exact: triangle_tests(&exact),
         approximate: triangle_tests(&approximate),
-        tolerance_no: triangle_tests(&no.stats),
-        tolerance_yes: triangle_tests(&yes.stats),
+        tolerance_no: triangle_tests(&no.work),
+        tolerance_yes: triangle_tests(&yes.work),
     }
 }
 
 #[test]
 fn distance_work_does_not_grow_with_the_offset() {
     let cow = common::cow();
-    let mut context = QueryContext::new();
     for bv in [BvKind::Obb, BvKind::Aabb] {
         for precision in Precision::ALL {
             let options = BuildOptions {
@@ -84,18 +84,17 @@ fn distance_work_does_not_grow_with_the_offset() {
                 ..BuildOptions::default()
             };
             let file = build(&cow, &options, None).unwrap();
+            let mut pair = PairQuery::new(&file, &file).unwrap();
             for direction in [Vector3::x(), Vector3::new(1.0, -1.0, 1.0)] {
                 let mut baseline: Option<Work> = None;
                 for offset in OFFSETS {
                     let pose = pose_b(offset, direction);
                     let a = Pose::identity();
                     let exact = DistanceOptions::default();
-                    let d = distance_files(&file, &a, &file, &pose, &exact, &mut context)
-                        .unwrap()
-                        .distance;
+                    let d = pair.distance(&a, &pose, &exact).unwrap().distance();
                     // The cow is about 1 unit across: the gap is the offset less about that.
                     assert!(d > offset - 2.0 && d < offset, "{offset}: distance {d}");
-                    let w = work(&file, &pose, d, &mut context);
+                    let w = work(&mut pair, &pose, d);
                     let label = format!("{bv:?} {precision:?} along {direction:?} at {offset:e}");
                     let base = baseline.get_or_insert(Work { ..w });
                     for (what, now, then) in [
@@ -110,17 +109,9 @@ fn distance_work_does_not_grow_with_the_offset() {
                         );
                     }
                     // Far apart, collision is decided at the roots.
-                    let hit = collide_files(
-                        &file,
-                        &a,
-                        &file,
-                        &pose,
-                        &CollideOptions::default(),
-                        &mut context,
-                    )
-                    .unwrap();
+                    let hit = pair.collide(&a, &pose, &CollideOptions::default()).unwrap();
                     assert!(!hit.colliding);
-                    assert_eq!(hit.stats.nodes_visited, 1, "{label}");
+                    assert_eq!(hit.work.nodes_visited, 1, "{label}");
                 }
             }
         }
@@ -128,11 +119,11 @@ fn distance_work_does_not_grow_with_the_offset() {
 }
 
 /// The exact distance between the model at the identity and a copy moved `offset` along
-/// x, and that copy's pose.
-fn along_x(file: &ObbtFile, offset: f64, context: &mut QueryContext) -> (Pose, DistanceResult) {
+/// x (`pair` is the model against itself), and that copy's pose.
+fn along_x(pair: &mut PairQuery<'_>, offset: f64) -> (Pose, DistanceResult) {
     let pose = Pose::translation(offset, 0.0, 0.0);
     let exact = DistanceOptions::default();
-    let r = distance_files(file, &Pose::identity(), file, &pose, &exact, context).unwrap();
+    let r = pair.distance(&Pose::identity(), &pose, &exact).unwrap();
     (pose, r)
 }
 
@@ -143,13 +134,13 @@ fn along_x(file: &ObbtFile, offset: f64, context: &mut QueryContext) -> (Pose, D
 #[test]
 fn far_distances_stay_exact() {
     let cow = common::cow();
-    let mut context = QueryContext::new();
     for precision in Precision::ALL {
         let options = BuildOptions {
             precision,
             ..BuildOptions::default()
         };
         let file = build(&cow, &options, None).unwrap();
+        let mut pair = PairQuery::new(&file, &file).unwrap();
         let triangles: Vec<Triangle> = common::file_triangles(&file)
             .iter()
             .map(|(_, t)| t.map(Vector3::from))
@@ -175,7 +166,7 @@ fn far_distances_stay_exact() {
             .copied()
             .collect();
         for offset in OFFSETS {
-            let (pose, r) = along_x(&file, offset, &mut context);
+            let (pose, r) = along_x(&mut pair, offset);
             let left_of_b = oracle::in_frame_of_a(&Pose::identity(), &pose, &left);
             let brute = oracle::min_distance(&right, &left_of_b);
             assert!(
@@ -183,9 +174,9 @@ fn far_distances_stay_exact() {
                 "the slabs hold the answer"
             );
             assert!(
-                (r.distance - brute).abs() <= 8.0 * f64::EPSILON * offset,
+                (r.distance() - brute).abs() <= 8.0 * f64::EPSILON * offset,
                 "{precision:?} at {offset:e}: {} vs brute force {brute}",
-                r.distance
+                r.distance()
             );
         }
     }
@@ -199,19 +190,15 @@ fn far_distances_stay_exact() {
 fn models_beyond_f64_resolution_do_not_open_every_pair() {
     let cow = common::cow();
     let file = build(&cow, &BuildOptions::default(), None).unwrap();
-    let mut context = QueryContext::new();
+    let mut pair = PairQuery::new(&file, &file).unwrap();
     for offset in [1e13, 1e16, 1e100, 1e300] {
-        let (_, r) = along_x(&file, offset, &mut context);
-        assert!(
-            triangle_tests(&r.stats) <= 1000,
-            "{offset:e}: {:?}",
-            r.stats
-        );
+        let (_, r) = along_x(&mut pair, offset);
+        assert!(triangle_tests(&r.work) <= 1000, "{offset:e}: {:?}", r.work);
         // The cow is about 1 unit wide: the distance is the offset less that.
         assert!(
-            (r.distance - (offset - 1.0)).abs() <= 1.0 + 1e-13 * offset,
+            (r.distance() - (offset - 1.0)).abs() <= 1.0 + 1e-13 * offset,
             "{offset:e}: {}",
-            r.distance
+            r.distance()
         );
     }
 }

@@ -24,8 +24,7 @@ use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
 use obbtree::query::triangle::Triangle;
 use obbtree::query::{
-    collide_files, distance_files, within_tolerance_files, CollideOptions, DistanceOptions, Pose,
-    QueryContext,
+    CollideOptions, DistanceOptions, PairQuery, Pose, QueryContext, ToleranceOptions,
 };
 use obbtree::real::Precision;
 
@@ -96,42 +95,32 @@ fn check_scene(name: &str, a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pos
         let tb = world_triangles(b, options.precision, pose_b);
         let pairs = oracle::contact_pairs(&ta, &tb);
         let reference = oracle::min_distance(&ta, &tb);
+        let mut pair = PairQuery::with_context(&fa, &fb, std::mem::take(&mut context)).unwrap();
 
-        let all = collide_files(
-            &fa,
-            pose_a,
-            &fb,
-            pose_b,
-            &CollideOptions::default(),
-            &mut context,
-        )
-        .unwrap();
+        let all = pair
+            .collide(pose_a, pose_b, &CollideOptions::default())
+            .unwrap();
         assert_eq!(all.pairs, pairs, "{what}: contacting pairs");
         let first = CollideOptions {
             first_contact: true,
             ..CollideOptions::default()
         };
-        let one = collide_files(&fa, pose_a, &fb, pose_b, &first, &mut context).unwrap();
+        let one = pair.collide(pose_a, pose_b, &first).unwrap();
         assert_eq!(one.colliding, !pairs.is_empty(), "{what}: first contact");
-        let d = distance_files(
-            &fa,
-            pose_a,
-            &fb,
-            pose_b,
-            &DistanceOptions::default(),
-            &mut context,
-        )
-        .unwrap();
+        let d = pair
+            .distance(pose_a, pose_b, &DistanceOptions::default())
+            .unwrap();
         assert!(
-            (d.distance - reference).abs() <= 1e-12 * reference.max(1e-300),
+            (d.distance() - reference).abs() <= 1e-12 * reference.max(1e-300),
             "{what}: distance {} against brute force {reference}",
-            d.distance
+            d.distance()
         );
         match expect {
             Expect::Contact => {
                 assert!(all.colliding, "{what}: contact expected");
                 assert_eq!(
-                    d.distance, 0.0,
+                    d.distance(),
+                    0.0,
                     "{what}: touching surfaces are at distance 0"
                 );
             }
@@ -140,26 +129,22 @@ fn check_scene(name: &str, a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pos
                 let tolerance =
                     hand_tolerance(gap, options.precision, magnitude(&ta).max(magnitude(&tb)));
                 assert!(
-                    (d.distance - gap).abs() <= tolerance,
+                    (d.distance() - gap).abs() <= tolerance,
                     "{what}: distance {} against {gap} by hand",
-                    d.distance
+                    d.distance()
                 );
                 // "Closer than t" agrees on both sides of the gap.
                 for (t, closer) in [(gap * 0.5, false), (gap * 2.0, true)] {
-                    let r = within_tolerance_files(
-                        &fa,
-                        pose_a,
-                        &fb,
-                        pose_b,
-                        t,
-                        obbtree::query::DescentRule::default(),
-                        &mut context,
-                    )
-                    .unwrap();
-                    assert_eq!(r.closer, closer, "{what}: tolerance {t}");
+                    let tolerance = ToleranceOptions {
+                        tolerance: t,
+                        rule: obbtree::query::DescentRule::default(),
+                    };
+                    let r = pair.within(pose_a, pose_b, &tolerance).unwrap();
+                    assert_eq!(r.closer(), closer, "{what}: tolerance {t}");
                 }
             }
         }
+        context = pair.into_context();
     }
 }
 
@@ -269,28 +254,22 @@ fn guard_case_without_the_guard_loses_real_contacts() {
                 ..BuildOptions::default()
             };
             let (fa, fb) = (built(&a, &options), built(&b, &options));
-            let guarded = collide_files(
-                &fa,
-                &Pose::identity(),
-                &fb,
-                &pose_b,
-                &CollideOptions::default(),
-                &mut context,
-            )
-            .unwrap();
+            let mut pair = PairQuery::with_context(&fa, &fb, std::mem::take(&mut context)).unwrap();
+            let guarded = pair
+                .collide(&Pose::identity(), &pose_b, &CollideOptions::default())
+                .unwrap();
             assert_eq!(guarded.pairs, truth, "{options:?}: guarded");
-            let unguarded = collide_files(
-                &fa,
-                &Pose::identity(),
-                &fb,
-                &pose_b,
-                &CollideOptions {
-                    guard: 0.0,
-                    ..CollideOptions::default()
-                },
-                &mut context,
-            )
-            .unwrap();
+            let unguarded = pair
+                .collide(
+                    &Pose::identity(),
+                    &pose_b,
+                    &CollideOptions {
+                        guard: 0.0,
+                        ..CollideOptions::default()
+                    },
+                )
+                .unwrap();
+            context = pair.into_context();
             // f32 frames are orthonormal only within 1e-6, and the slack that covers it
             // (4e-6 x the centre offset) is larger than this case's noise: only f64 files
             // show what the guard alone protects.
@@ -573,25 +552,15 @@ fn duplicated_triangles_are_reported_once_per_copy() {
     );
     // Every pair of the single cube appears twice, once per copy of A's triangle.
     let options = BuildOptions::default();
-    let mut context = QueryContext::new();
-    let single = collide_files(
-        &built(&cube, &options),
-        &Pose::identity(),
-        &built(&cube, &options),
-        &pose_b,
-        &CollideOptions::default(),
-        &mut context,
-    )
-    .unwrap();
-    let double = collide_files(
-        &built(&doubled, &options),
-        &Pose::identity(),
-        &built(&cube, &options),
-        &pose_b,
-        &CollideOptions::default(),
-        &mut context,
-    )
-    .unwrap();
+    let (cube_file, doubled_file) = (built(&cube, &options), built(&doubled, &options));
+    let single = PairQuery::new(&cube_file, &cube_file)
+        .unwrap()
+        .collide(&Pose::identity(), &pose_b, &CollideOptions::default())
+        .unwrap();
+    let double = PairQuery::new(&doubled_file, &cube_file)
+        .unwrap()
+        .collide(&Pose::identity(), &pose_b, &CollideOptions::default())
+        .unwrap();
     let mut expected: Vec<(u32, u32)> = single
         .pairs
         .iter()
@@ -761,26 +730,16 @@ fn near_contact(
         ..BuildOptions::default()
     };
     let (fa, fb) = (built(&a, &options), built(&b, &options));
-    let hit = collide_files(
-        &fa,
-        &pose_a,
-        &fb,
-        &pose_b,
-        &CollideOptions::default(),
-        context,
-    )
-    .unwrap()
-    .colliding;
-    let d = distance_files(
-        &fa,
-        &pose_a,
-        &fb,
-        &pose_b,
-        &DistanceOptions::default(),
-        context,
-    )
-    .unwrap()
-    .distance;
+    let mut pair = PairQuery::with_context(&fa, &fb, std::mem::take(context)).unwrap();
+    let hit = pair
+        .collide(&pose_a, &pose_b, &CollideOptions::default())
+        .unwrap()
+        .colliding;
+    let d = pair
+        .distance(&pose_a, &pose_b, &DistanceOptions::default())
+        .unwrap()
+        .distance();
+    *context = pair.into_context();
     // Contact flips exactly where the seen gap closes.
     assert_eq!(hit, seen <= 0.0, "{what}: contact, seen gap {seen:e}");
     let magnitude = va
@@ -859,16 +818,13 @@ fn near_contact_under_a_common_rotation_keeps_the_distance_error_bound() {
                     let pose_a = Pose::new(r, base).unwrap();
                     let pose_b =
                         Pose::new(r, base + r * Vector3::new(2.0 * s + gap, 0.0, 0.0)).unwrap();
-                    let d = distance_files(
-                        &f,
-                        &pose_a,
-                        &f,
-                        &pose_b,
-                        &DistanceOptions::default(),
-                        &mut context,
-                    )
-                    .unwrap()
-                    .distance;
+                    let mut pair =
+                        PairQuery::with_context(&f, &f, std::mem::take(&mut context)).unwrap();
+                    let d = pair
+                        .distance(&pose_a, &pose_b, &DistanceOptions::default())
+                        .unwrap()
+                        .distance();
+                    context = pair.into_context();
                     // The poses hold the gap only to the rounding of their translations
                     // (magnitude o + 2s) and of the relative rotation (magnitude s).
                     let bound = 4.0 * f64::EPSILON * (o + 2.0 * s) + distance_error_bound(4.0 * s);
@@ -926,44 +882,30 @@ fn a_million_eccentric_slivers() {
         &[[0, 1, 2], [0, 2, 3]],
     );
     let wall_file = built(&wall, &options);
-    let mut context = QueryContext::new();
-    let r = collide_files(
-        &file,
-        &Pose::identity(),
-        &wall_file,
-        &Pose::identity(),
-        &CollideOptions::default(),
-        &mut context,
-    )
-    .unwrap();
+    let mut pair = PairQuery::new(&file, &wall_file).unwrap();
+    let r = pair
+        .collide(
+            &Pose::identity(),
+            &Pose::identity(),
+            &CollideOptions::default(),
+        )
+        .unwrap();
     let mut touched: Vec<u32> = r.pairs.iter().map(|&(a, _)| a).collect();
     touched.dedup();
     assert_eq!(touched, (k..=m).collect::<Vec<_>>());
-    assert_eq!(r.stats.identity_value(), 1);
+    assert_eq!(r.work.identity_value(), 1);
     // Lifted 2^-30 above the plane the wall is that far away, and nothing touches.
     let g = 2f64.powi(-30);
     let lifted = shifted(0.0, 0.0, 1.0 + g);
-    let d = distance_files(
-        &file,
-        &Pose::identity(),
-        &wall_file,
-        &lifted,
-        &DistanceOptions::default(),
-        &mut context,
-    )
-    .unwrap();
-    assert!((d.distance - g).abs() <= 1e-12 * g, "{}", d.distance);
+    let d = pair
+        .distance(&Pose::identity(), &lifted, &DistanceOptions::default())
+        .unwrap();
+    assert!((d.distance() - g).abs() <= 1e-12 * g, "{}", d.distance());
     assert!(
-        !collide_files(
-            &file,
-            &Pose::identity(),
-            &wall_file,
-            &lifted,
-            &CollideOptions::default(),
-            &mut context
-        )
-        .unwrap()
-        .colliding
+        !pair
+            .collide(&Pose::identity(), &lifted, &CollideOptions::default())
+            .unwrap()
+            .colliding
     );
 }
 
@@ -1016,20 +958,13 @@ fn the_cube_gets_a_tight_box_in_any_orientation() {
 /// corrupt tree. Models far apart but within range get their exact, finite distance.
 #[test]
 fn distances_beyond_the_f64_range_are_infinite_not_errors() {
-    let mut context = QueryContext::new();
     for options in common::all_options() {
         let cube = built(&common::cube(1.0), &options);
+        let mut pair = PairQuery::new(&cube, &cube).unwrap();
         let mut distance_to = |pose_b: &Pose| {
-            distance_files(
-                &cube,
-                &Pose::identity(),
-                &cube,
-                pose_b,
-                &DistanceOptions::default(),
-                &mut context,
-            )
-            .expect("an answer")
-            .distance
+            pair.distance(&Pose::identity(), pose_b, &DistanceOptions::default())
+                .expect("an answer")
+                .distance()
         };
         let overflow = distance_to(&shifted(-1.7e308, 1.7e308, 0.0));
         assert_eq!(overflow, f64::INFINITY, "{options:?}");

@@ -25,7 +25,7 @@ use common::seal::seal;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
 use obbtree::format::{AlignedBytes, FormatError, ObbtFile};
-use obbtree::query::{collide_files, CollideOptions, Pose, QueryContext, QueryError};
+use obbtree::query::{CollideOptions, PairQuery, Pose, QueryError};
 use obbtree::real::Precision;
 use rayon::prelude::*;
 
@@ -527,16 +527,11 @@ fn refused_by_verify(file: &ObbtFile, needle: &str, what: &str) -> Option<QueryE
     let partner = build(&common::cube(0.5), &BuildOptions::default(), None).expect("builds");
     let poses = Poses::for_size(2.0);
     exercise(file.bytes(), &partner, &poses, false);
-    let mut context = QueryContext::new();
-    collide_files(
-        file,
-        &Pose::identity(),
-        file,
-        &poses.span,
-        &CollideOptions::default(),
-        &mut context,
-    )
-    .err()
+    PairQuery::new(file, file)
+        .and_then(|mut pair| {
+            pair.collide(&Pose::identity(), &poses.span, &CollideOptions::default())
+        })
+        .err()
 }
 
 fn binary_file() -> ObbtFile {

@@ -12,13 +12,15 @@ mod common;
 use common::oracle;
 use nalgebra::{Rotation3, Vector3};
 use obbtree::build::build;
+use obbtree::bv::BoundingVolume;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
+use obbtree::query::details::{self, QueryContext};
 use obbtree::query::triangle::{triangle_distance, Triangle};
 use obbtree::query::{
-    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, PairQuery, Pose, QueryContext,
+    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, SpanOptions, ToleranceOptions,
 };
+use obbtree::tree::TreeView;
 use proptest::prelude::*;
 
 /// The stored triangles of a file, by input-mesh id, in its model frame.
@@ -68,58 +70,73 @@ fn point_on_triangle(p: &Vector3<f64>, t: &Triangle, tolerance: f64) -> bool {
     triangle_distance(&[*p, *p, *p], t).distance <= tolerance
 }
 
-fn check_all(
-    mesh_a: &TriMesh,
-    mesh_b: &TriMesh,
-    pose_a: &Pose,
-    pose_b: &Pose,
-) -> Result<(), TestCaseError> {
-    let mut context = QueryContext::new();
-    for options in common::all_options() {
-        let fa = build(mesh_a, &options, None).unwrap();
-        let fb = build(mesh_b, &options, None).unwrap();
-        let (ta, tb) = (stored(&fa), stored(&fb));
-        let brute = oracle::Answers::of(&ta, &oracle::in_frame_of_a(pose_a, pose_b, &tb));
-        let binary = fa.info().leaf_size == 1 && fb.info().leaf_size == 1;
+/// The queries over typed views ([`details`]) against brute force, for every descent
+/// rule: what [`check_all`] runs on each build's views.
+struct CheckViews<'a> {
+    what: String,
+    pose_a: &'a Pose,
+    pose_b: &'a Pose,
+    ta: &'a [Triangle],
+    tb: &'a [Triangle],
+    brute: &'a oracle::Answers,
+    binary: bool,
+    context: &'a mut QueryContext,
+}
+
+impl common::ViewsVisitor for CheckViews<'_> {
+    type Output = Result<(), TestCaseError>;
+
+    fn visit<B: BoundingVolume>(self, va: &TreeView<'_, B>, vb: &TreeView<'_, B>) -> Self::Output {
+        let CheckViews {
+            what: options,
+            pose_a,
+            pose_b,
+            ta,
+            tb,
+            brute,
+            binary,
+            context,
+        } = self;
         for rule in DescentRule::ALL {
-            let what = format!("{options:?} {rule:?}");
-            let all = collide_files(
-                &fa,
+            let what = format!("{options} {rule:?}");
+            let all = details::collide(
+                va,
                 pose_a,
-                &fb,
+                vb,
                 pose_b,
                 &CollideOptions {
                     rule,
                     ..CollideOptions::default()
                 },
-                &mut context,
+                context,
             )
             .unwrap();
             prop_assert_eq!(&all.pairs, &brute.pairs, "{}", what);
             if binary {
-                prop_assert_eq!(all.stats.identity_value(), 1, "{} {:?}", what, all.stats);
+                prop_assert_eq!(all.work.identity_value(), 1, "{} {:?}", what, all.work);
             }
             let first = CollideOptions {
                 rule,
                 first_contact: true,
                 ..CollideOptions::default()
             };
-            let one = collide_files(&fa, pose_a, &fb, pose_b, &first, &mut context).unwrap();
+            let one = details::collide(va, pose_a, vb, pose_b, &first, context).unwrap();
             prop_assert_eq!(one.colliding, !brute.pairs.is_empty(), "{}", what);
             prop_assert!(one.pairs.iter().all(|p| brute.pairs.contains(p)));
 
-            let d = distance_files(
-                &fa,
+            let r = details::distance(
+                va,
                 pose_a,
-                &fb,
+                vb,
                 pose_b,
                 &DistanceOptions {
                     rule,
                     ..DistanceOptions::default()
                 },
-                &mut context,
+                context,
             )
             .unwrap();
+            let d = r.closest.expect("no maximum distance");
             let scale = 1.0 + brute.min_distance;
             prop_assert!(
                 (d.distance - brute.min_distance).abs() <= 1e-9 * scale,
@@ -143,47 +160,100 @@ fn check_all(
             ));
             prop_assert!(((d.point_a - d.point_b).norm() - d.distance).abs() <= 1e-9 * scale);
             if binary && d.distance > 0.0 {
-                prop_assert_eq!(d.stats.identity_value(), 1, "{} {:?}", what, d.stats);
+                prop_assert_eq!(r.work.identity_value(), 1, "{} {:?}", what, r.work);
             }
 
-            let s = span_files(&fa, pose_a, &fb, pose_b, rule, &mut context).unwrap();
+            let s = details::span(va, pose_a, vb, pose_b, &SpanOptions { rule }, context).unwrap();
             prop_assert!(
-                (s.span - brute.max_distance).abs() <= 1e-9 * (1.0 + brute.max_distance),
+                (s.span() - brute.max_distance).abs() <= 1e-9 * (1.0 + brute.max_distance),
                 "{} span {} vs {}",
                 what,
-                s.span,
+                s.span(),
                 brute.max_distance
             );
-            prop_assert!(((s.point_a - s.point_b).norm() - s.span).abs() <= 1e-9 * (1.0 + s.span));
+            let far = s.farthest;
+            prop_assert!(
+                ((far.point_a - far.point_b).norm() - s.span()).abs() <= 1e-9 * (1.0 + s.span())
+            );
             if binary {
-                prop_assert_eq!(s.stats.identity_value(), 1, "{} {:?}", what, s.stats);
+                prop_assert_eq!(s.work.identity_value(), 1, "{} {:?}", what, s.work);
             }
         }
         // Tolerance: agrees with the exact distance away from the threshold.
         for t in [brute.min_distance * 0.5, brute.min_distance * 1.5 + 1e-9] {
-            let r = within_tolerance_files(
-                &fa,
-                pose_a,
-                &fb,
-                pose_b,
-                t,
-                DescentRule::default(),
-                &mut context,
-            )
-            .unwrap();
-            prop_assert_eq!(r.closer, brute.min_distance < t);
+            let tolerance = ToleranceOptions {
+                tolerance: t,
+                rule: DescentRule::default(),
+            };
+            let r = details::within(va, pose_a, vb, pose_b, &tolerance, context).unwrap();
+            prop_assert_eq!(r.closer(), brute.min_distance < t);
             if let Some(w) = r.witness {
                 prop_assert!(w.distance < t);
             }
         }
-        // The pair object answers as the free functions do; a limit gives `None` exactly
-        // when the distance reaches it; a warm start from any pair changes nothing but work.
+        // Approximate distance keeps its documented guarantee.
+        for (rel, abs) in [(0.1, 0.0), (0.0, 0.05), (0.5, 0.01)] {
+            let o = DistanceOptions {
+                rel_err: rel,
+                abs_err: abs,
+                ..DistanceOptions::default()
+            };
+            let d = details::distance(va, pose_a, vb, pose_b, &o, context)
+                .unwrap()
+                .distance();
+            let exact = brute.min_distance;
+            prop_assert!(d >= exact - 1e-9 * (1.0 + exact));
+            prop_assert!(d <= (exact * (1.0 + rel)).max(exact + abs) + 1e-9 * (1.0 + exact));
+        }
+        Ok(())
+    }
+}
+
+fn check_all(
+    mesh_a: &TriMesh,
+    mesh_b: &TriMesh,
+    pose_a: &Pose,
+    pose_b: &Pose,
+) -> Result<(), TestCaseError> {
+    let mut context = QueryContext::new();
+    for options in common::all_options() {
+        let fa = build(mesh_a, &options, None).unwrap();
+        let fb = build(mesh_b, &options, None).unwrap();
+        let (ta, tb) = (stored(&fa), stored(&fb));
+        let brute = oracle::Answers::of(&ta, &oracle::in_frame_of_a(pose_a, pose_b, &tb));
+        let binary = fa.info().leaf_size == 1 && fb.info().leaf_size == 1;
+        common::with_views(
+            &fa,
+            &fb,
+            CheckViews {
+                what: format!("{options:?}"),
+                pose_a,
+                pose_b,
+                ta: &ta,
+                tb: &tb,
+                brute: &brute,
+                binary,
+                context: &mut context,
+            },
+        )?;
+        // The pair object answers as the typed functions do; a maximum distance gives no
+        // pair exactly when the distance reaches it; a warm start from any pair changes
+        // nothing but work.
         let mut pair = PairQuery::new(&fa, &fb).unwrap();
         let all = pair
             .collide(pose_a, pose_b, &CollideOptions::default())
             .unwrap();
         prop_assert_eq!(&all.pairs, &brute.pairs);
-        let first = pair.first_contact(pose_a, pose_b).unwrap();
+        let first_contact = CollideOptions {
+            first_contact: true,
+            ..CollideOptions::default()
+        };
+        let first = pair
+            .collide(pose_a, pose_b, &first_contact)
+            .unwrap()
+            .pairs
+            .first()
+            .copied();
         prop_assert_eq!(first.is_some(), !brute.pairs.is_empty());
         prop_assert!(first.is_none_or(|p| brute.pairs.contains(&p)));
         let exact = DistanceOptions::default();
@@ -193,7 +263,11 @@ fn check_all(
             pose_b.translation_vector() + Vector3::new(0.3, -0.2, 0.1),
         )
         .unwrap();
-        let elsewhere = pair.distance(pose_a, &moved, &exact).unwrap().witness;
+        let elsewhere = pair
+            .distance(pose_a, &moved, &exact)
+            .unwrap()
+            .warm_start
+            .expect("no maximum distance");
         // Limits, also with an error allowance and a warm start from another pose (whose
         // pair may lie beyond the limit: the allowance must not then hide closer pairs).
         let approximate = DistanceOptions {
@@ -204,7 +278,11 @@ fn check_all(
         let limits = [0.5, 1.05, 1.5].map(|f| brute.min_distance * f + 1e-9);
         for limit in limits {
             for (options, rel) in [(&exact, 0.0), (&approximate, 0.3)] {
-                let (r, _) = pair.distance_below(pose_a, pose_b, options, limit).unwrap();
+                let below = DistanceOptions {
+                    max_distance: limit,
+                    ..*options
+                };
+                let r = pair.distance(pose_a, pose_b, &below).unwrap().closest;
                 match r {
                     Some(r) => {
                         prop_assert!(brute.min_distance < limit);
@@ -216,28 +294,15 @@ fn check_all(
             }
         }
         let cold = pair.distance(pose_a, pose_b, &exact).unwrap();
-        for start in [cold.witness, elsewhere] {
+        let cold_start = cold.warm_start.expect("no maximum distance");
+        for start in [cold_start, elsewhere] {
             let warm = DistanceOptions {
                 warm_start: Some(start),
                 ..DistanceOptions::default()
             };
             let d = pair.distance(pose_a, pose_b, &warm).unwrap();
-            prop_assert!((d.distance - brute.min_distance).abs() <= 1e-9 * scale);
-            prop_assert!(d.stats.tri_separated + d.stats.tri_contact >= 1);
-        }
-        // Approximate distance keeps its documented guarantee.
-        for (rel, abs) in [(0.1, 0.0), (0.0, 0.05), (0.5, 0.01)] {
-            let o = DistanceOptions {
-                rel_err: rel,
-                abs_err: abs,
-                ..DistanceOptions::default()
-            };
-            let d = distance_files(&fa, pose_a, &fb, pose_b, &o, &mut context).unwrap();
-            let exact = brute.min_distance;
-            prop_assert!(d.distance >= exact - 1e-9 * (1.0 + exact));
-            prop_assert!(
-                d.distance <= (exact * (1.0 + rel)).max(exact + abs) + 1e-9 * (1.0 + exact)
-            );
+            prop_assert!((d.distance() - brute.min_distance).abs() <= 1e-9 * scale);
+            prop_assert!(d.work.tri_separated + d.work.tri_contact >= 1);
         }
     }
     Ok(())
@@ -321,16 +386,21 @@ fn a_pair_query_refuses_trees_of_different_kinds_and_reuses_its_buffers() {
     )
     .unwrap();
     assert_eq!(result.pairs.as_ptr(), buffer);
-    let mut context = QueryContext::new();
-    let expected = collide_files(
-        &obb,
-        &Pose::identity(),
-        &obb,
-        &further,
-        &CollideOptions::default(),
-        &mut context,
-    )
-    .unwrap();
+    // And it answers as the typed function does.
+    struct Collide<'a>(&'a Pose);
+    impl common::ViewsVisitor for Collide<'_> {
+        type Output = obbtree::query::CollideResult;
+        fn visit<B: BoundingVolume>(
+            self,
+            a: &TreeView<'_, B>,
+            b: &TreeView<'_, B>,
+        ) -> Self::Output {
+            let mut context = QueryContext::new();
+            let (here, options) = (Pose::identity(), CollideOptions::default());
+            details::collide(a, &here, b, self.0, &options, &mut context).unwrap()
+        }
+    }
+    let expected = common::with_views(&obb, &obb, Collide(&further));
     assert_eq!(result, expected);
 }
 
@@ -360,10 +430,10 @@ fn warm_started_distances_equal_cold_ones_with_less_work() {
                 },
             )
             .unwrap();
-        assert_eq!(warm.distance, cold.distance, "step {step}");
-        previous = Some(warm.witness);
-        cold_work += cold.stats.nodes_visited;
-        warm_work += warm.stats.nodes_visited;
+        assert_eq!(warm.distance(), cold.distance(), "step {step}");
+        previous = warm.warm_start;
+        cold_work += cold.work.nodes_visited;
+        warm_work += warm.work.nodes_visited;
     }
     assert!(warm_work < cold_work, "warm {warm_work} cold {cold_work}");
 }

@@ -12,9 +12,7 @@ use obbtree::build::{build, BuildError, BuildOptions};
 use obbtree::format::layout::{SectionKind, PLACEMENT_STRIDE};
 use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::mesh::TriMesh;
-use obbtree::query::{
-    collide_files, distance_files, CollideOptions, DistanceOptions, Pose, QueryContext,
-};
+use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
 use obbtree::real::Precision;
 
 /// Where the far-away copies of the cow sit: the "offset of −982 from their origin" of real
@@ -77,21 +75,16 @@ fn assert_same_answers(
     b: &ObbtFile,
     rel: f64,
 ) {
-    let mut context = QueryContext::new();
     // The pair under test, then the reference pair.
-    let sides = [(a, pose_a), (reference, reference_pose)];
+    let mut sides = [(a, pose_a), (reference, reference_pose)].map(|(file, pose)| {
+        let pair = PairQuery::new(file, b).expect("same volume and precision");
+        (pair, pose)
+    });
     let mut contacts = 0;
     for pose_b in poses(&[0.15, 0.4, 0.7]) {
-        let [got, want] = sides.map(|(file, pose)| {
-            collide_files(
-                file,
-                pose,
-                b,
-                &pose_b,
-                &CollideOptions::default(),
-                &mut context,
-            )
-            .expect("same volume and precision")
+        let [got, want] = sides.each_mut().map(|(pair, pose)| {
+            pair.collide(pose, &pose_b, &CollideOptions::default())
+                .expect("collides")
         });
         assert_eq!(got.pairs, want.pairs, "contacts at {pose_b:?}");
         contacts += want.pairs.len();
@@ -101,16 +94,11 @@ fn assert_same_answers(
         "the collision poses must touch ({contacts})"
     );
     for pose_b in poses(&[1.3, 2.0, 7.5]) {
-        let [got, want] = sides.map(|(file, pose)| {
-            distance_files(
-                file,
-                pose,
-                b,
-                &pose_b,
-                &DistanceOptions::default(),
-                &mut context,
-            )
-            .expect("same volume and precision")
+        let [got, want] = sides.each_mut().map(|(pair, pose)| {
+            pair.distance(pose, &pose_b, &DistanceOptions::default())
+                .expect("a distance")
+                .closest
+                .expect("no maximum distance")
         });
         assert!(want.distance > 0.0, "the distance poses must be apart");
         assert!(
@@ -296,14 +284,15 @@ fn center_brings_a_far_model_to_its_origin() {
     // Why it matters for f32 files: f32 rounds a coordinate near 0.5 by up to 3e-8, one
     // near 982 by up to 3e-5. The far cow stored as it is (and posed back by −FAR) answers
     // with that error; centred, it answers like the cow built at its origin.
-    let mut context = QueryContext::new();
     let pose_b = Pose::translation(1.3, 0.2, 0.0);
-    let distance = |a: &ObbtFile, pose_a: &Pose, b: &ObbtFile, context: &mut QueryContext| {
-        distance_files(a, pose_a, b, &pose_b, &DistanceOptions::default(), context)
+    let distance = |a: &ObbtFile, pose_a: &Pose, b: &ObbtFile| {
+        PairQuery::new(a, b)
             .expect("same volume and precision")
-            .distance
+            .distance(pose_a, &pose_b, &DistanceOptions::default())
+            .expect("a distance")
+            .distance()
     };
-    let reference = distance(&plain, &Pose::identity(), &plain, &mut context);
+    let reference = distance(&plain, &Pose::identity(), &plain);
     let f32_centred = build(
         &far,
         &BuildOptions {
@@ -314,12 +303,11 @@ fn center_brings_a_far_model_to_its_origin() {
     )
     .expect("builds");
     let f32_plain = build(&cow, &BuildOptions::default(), None).expect("builds");
-    let error =
-        (distance(&f32_centred, &Pose::identity(), &f32_plain, &mut context) - reference).abs();
+    let error = (distance(&f32_centred, &Pose::identity(), &f32_plain) - reference).abs();
     assert!(error < 1e-7, "centred f32 file: distance off by {error}");
     let f32_far = build(&far, &BuildOptions::default(), None).expect("builds");
     let back = Pose::translation(-FAR[0], -FAR[1], -FAR[2]);
-    let far_error = (distance(&f32_far, &back, &f32_plain, &mut context) - reference).abs();
+    let far_error = (distance(&f32_far, &back, &f32_plain) - reference).abs();
     assert!(
         far_error > 10.0 * error,
         "uncentred f32 file: distance off by {far_error}, centred by {error}"

@@ -17,7 +17,10 @@ use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
-use obbtree::query::{CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, Stats};
+use obbtree::query::{
+    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, SpanOptions, ToleranceOptions,
+    Work,
+};
 
 /// `(query, [D, I, S, K, node pairs visited])`, volume type first in the name.
 #[rustfmt::skip]
@@ -75,7 +78,7 @@ const PINNED: &[(&str, [u64; 5])] = &[
 /// One query of the table: its name and what it runs.
 struct Case {
     name: String,
-    run: Box<dyn Fn(&mut PairQuery<'_>) -> Stats>,
+    run: Box<dyn Fn(&mut PairQuery<'_>) -> Work>,
     /// Whether the traversal runs to the end (every pair it opens is tested), so that
     /// `D − I + 2S + 2K = 1` holds on binary trees with one face per leaf.
     complete: bool,
@@ -89,7 +92,7 @@ fn collide(x: f64) -> Case {
             let options = CollideOptions::default();
             pair.collide(&Pose::identity(), &pose, &options)
                 .expect("collide")
-                .stats
+                .work
         }),
         complete: true,
     }
@@ -99,9 +102,13 @@ fn first_contact(name: String, pose: Pose) -> Case {
     Case {
         name,
         run: Box::new(move |pair| {
-            pair.first_contact_stats(&Pose::identity(), &pose)
+            let options = CollideOptions {
+                first_contact: true,
+                ..CollideOptions::default()
+            };
+            pair.collide(&Pose::identity(), &pose, &options)
                 .expect("first contact")
-                .1
+                .work
         }),
         complete: false,
     }
@@ -117,7 +124,7 @@ fn distance(name: String, pose: Pose, rel_err: f64, complete: bool) -> Case {
             };
             pair.distance(&Pose::identity(), &pose, &options)
                 .expect("distance")
-                .stats
+                .work
         }),
         complete,
     }
@@ -145,9 +152,13 @@ fn sphere_cases() -> Vec<Case> {
         name: "tolerance 0.05 x=1.83".into(),
         run: Box::new(|pair| {
             let pose = common::sliding_pose(1.83, 5);
-            pair.within_tolerance(&Pose::identity(), &pose, 0.05, DescentRule::default())
+            let options = ToleranceOptions {
+                tolerance: 0.05,
+                rule: DescentRule::default(),
+            };
+            pair.within(&Pose::identity(), &pose, &options)
                 .expect("tolerance")
-                .stats
+                .work
         }),
         complete: false,
     });
@@ -155,9 +166,12 @@ fn sphere_cases() -> Vec<Case> {
         name: "span x=1".into(),
         run: Box::new(|pair| {
             let pose = common::sliding_pose(1.0, 5);
-            pair.span(&Pose::identity(), &pose, DescentRule::default())
+            let options = SpanOptions {
+                rule: DescentRule::default(),
+            };
+            pair.span(&Pose::identity(), &pose, &options)
                 .expect("span")
-                .stats
+                .work
         }),
         complete: false,
     });
@@ -189,7 +203,7 @@ fn cow_cases() -> Vec<Case> {
                 let options = CollideOptions::default();
                 pair.collide(&Pose::identity(), &common::turned_pose(3, 0.3), &options)
                     .expect("collide")
-                    .stats
+                    .work
             }),
             complete: true,
         },

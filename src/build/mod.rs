@@ -8,7 +8,7 @@
 
 mod topdown;
 
-use crate::bv::{with_volume_type, BoundingVolume, BvKind};
+use crate::bv::{dispatch, BoundingVolume, BvKind, VolumeVisitor};
 use crate::fit::FitMethod;
 use crate::format::{self, ObbtFile, TreeImage, WriteError};
 use crate::mesh::TriMesh;
@@ -99,13 +99,9 @@ pub enum SphereFit {
 /// The default [`BuildOptions::hull_min_faces`]. The hull fit earns its cost on large nodes,
 /// whose triangles sample the shape unevenly or hide detail inside it (§3.4); on a small
 /// patch of surface its hull adds phantom faces across every concavity, and the triangles'
-/// own covariance gives boxes as tight or tighter. Measured on the bunny, fandisk, pig, cow
-/// and a 40k lat/long sphere against a turned copy (40 poses each): at 512 every mesh's
-/// trees made 0.8 to 6.8% fewer box tests in all-pairs collision than with the hull at every
-/// node, and distance queries visited up to 11% fewer node pairs (the sphere 1% more),
-/// while a one-thread build took 35 to 40% less time. 2048 built 12% faster against RAPID
-/// with as few box tests, but made `rel_err` and touching distance queries 6 and 12%
-/// slower against PQP in the same runs (README, "tried and not kept").
+/// own covariance gives boxes as tight or tighter. Below this size the triangles' frame made
+/// fewer box tests and faster builds on every benchmark mesh; a larger threshold built
+/// faster still but slowed distance queries (the figures are in docs/results).
 pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
 
 /// The default [`BuildOptions::hull_max_points`]. The top levels of a tree hold most of the
@@ -241,7 +237,24 @@ pub fn build(
     progress: Option<&AtomicU64>,
 ) -> Result<ObbtFile, BuildError> {
     options.validate()?;
-    with_volume_type!(options.bv, options.precision, B => build_as::<B>(mesh, options, progress))
+    /// [`build_as`] with the volume type the options name.
+    struct Build<'a> {
+        mesh: &'a TriMesh,
+        options: &'a BuildOptions,
+        progress: Option<&'a AtomicU64>,
+    }
+    impl VolumeVisitor for Build<'_> {
+        type Output = Result<ObbtFile, BuildError>;
+        fn visit<B: BoundingVolume>(self) -> Self::Output {
+            build_as::<B>(self.mesh, self.options, self.progress)
+        }
+    }
+    let visitor = Build {
+        mesh,
+        options,
+        progress,
+    };
+    dispatch(options.bv, options.precision, visitor)
 }
 
 fn build_as<B: BoundingVolume>(

@@ -17,48 +17,34 @@ pub use sphere::Sphere;
 
 use crate::arr3;
 use crate::pose::Pose;
-use crate::real::Real;
+use crate::real::{Precision, Real};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
-/// Evaluates `$body` with the type alias `$B` naming the stored volume type of a
-/// ([`BvKind`], [`crate::real::Precision`]) pair: the one place where the six combinations
-/// are spelt out (`$body` is expanded once for each). Adding a volume type means adding its
-/// two lines here, its [`BvKind`] and, for queries, its `ViewPair` variants.
-macro_rules! with_volume_type {
-    ($kind:expr, $precision:expr, $B:ident => $body:expr) => {{
-        use $crate::bv::BvKind as Kind;
-        use $crate::real::Precision as Scalar;
-        match ($kind, $precision) {
-            (Kind::Obb, Scalar::F32) => {
-                type $B = $crate::bv::Obb<f32>;
-                $body
-            }
-            (Kind::Obb, Scalar::F64) => {
-                type $B = $crate::bv::Obb<f64>;
-                $body
-            }
-            (Kind::Aabb, Scalar::F32) => {
-                type $B = $crate::bv::Aabb<f32>;
-                $body
-            }
-            (Kind::Aabb, Scalar::F64) => {
-                type $B = $crate::bv::Aabb<f64>;
-                $body
-            }
-            (Kind::Sphere, Scalar::F32) => {
-                type $B = $crate::bv::Sphere<f32>;
-                $body
-            }
-            (Kind::Sphere, Scalar::F64) => {
-                type $B = $crate::bv::Sphere<f64>;
-                $body
-            }
-        }
-    }};
+/// Generic code run on a volume type chosen at run time, from a ([`BvKind`],
+/// [`Precision`]) pair read from a header or an option: the one dispatch idiom of the
+/// crate. [`dispatch`] holds the one match over the combinations, so adding a volume type
+/// means adding its arms there and its [`BvKind`].
+pub trait VolumeVisitor {
+    /// What the visit returns.
+    type Output;
+    /// Called once, with `B` the stored volume type (and through it the precision).
+    fn visit<B: BoundingVolume>(self) -> Self::Output;
 }
-pub(crate) use with_volume_type;
+
+/// Runs `visitor` with the volume type of `kind` stored at `precision` (static dispatch:
+/// one match here, then monomorphised code).
+pub fn dispatch<V: VolumeVisitor>(kind: BvKind, precision: Precision, visitor: V) -> V::Output {
+    match (kind, precision) {
+        (BvKind::Obb, Precision::F32) => visitor.visit::<Obb<f32>>(),
+        (BvKind::Obb, Precision::F64) => visitor.visit::<Obb<f64>>(),
+        (BvKind::Aabb, Precision::F32) => visitor.visit::<Aabb<f32>>(),
+        (BvKind::Aabb, Precision::F64) => visitor.visit::<Aabb<f64>>(),
+        (BvKind::Sphere, Precision::F32) => visitor.visit::<Sphere<f32>>(),
+        (BvKind::Sphere, Precision::F64) => visitor.visit::<Sphere<f64>>(),
+    }
+}
 
 /// Which bounding volume a tree stores, as written in the file header.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -11,7 +11,7 @@ use obbtree::build::BuildOptions;
 use obbtree::bv::BvKind;
 use obbtree::format::{write_atomic, ObbtFile};
 use obbtree::mesh::TriMesh;
-use obbtree::query::{CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose};
+use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose, SpanOptions};
 use obbtree::scene::{load, FrameReader, LoadedScene};
 use std::io::BufReader;
 use std::path::PathBuf;
@@ -217,6 +217,10 @@ fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
     let extent = cow.info().stats.bounds_max[0] - cow.info().stats.bounds_min[0];
     let mut pair = PairQuery::new(&cow, &cow)?;
     let a = Pose::identity();
+    let first_contact = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
     out!("queries between two cows (A fixed, B turned 30 degrees about z and moved along x; lengths in model units):")?;
     for shift in [0.25, 0.6, 1.5] {
         let rotation = *Rotation3::from_euler_angles(0.0, 0.0, 30f64.to_radians()).matrix();
@@ -225,21 +229,21 @@ fn run_queries(path: &std::path::Path) -> Result<(), Failure> {
         let all = pair.collide(&a, &b, &CollideOptions::default())?;
         let collide = human_seconds(timed.elapsed().as_secs_f64());
         let timed = Instant::now();
-        let any = pair.first_contact(&a, &b)?;
+        let any = pair.collide(&a, &b, &first_contact)?;
         let first = human_seconds(timed.elapsed().as_secs_f64());
         let timed = Instant::now();
         let gap = pair.distance(&a, &b, &DistanceOptions::default())?;
         let distance = human_seconds(timed.elapsed().as_secs_f64());
         let timed = Instant::now();
-        let far = pair.span(&a, &b, DescentRule::default())?;
+        let far = pair.span(&a, &b, &SpanOptions::default())?;
         let span = human_seconds(timed.elapsed().as_secs_f64());
         out!(
             "  B at x = {:.3}: {} contacts ({collide}; first contact {} in {first}), distance {:.4} ({distance}), span {:.4} ({span})",
             shift * extent,
             all.pairs.len(),
-            if any.is_some() { "found" } else { "none" },
-            gap.distance,
-            far.span,
+            if any.colliding { "found" } else { "none" },
+            gap.distance(),
+            far.span(),
         )?;
     }
     Ok(())

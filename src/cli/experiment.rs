@@ -240,7 +240,7 @@ const ERROR_FLOOR: f64 = 1e-16;
 /// scene's Pareto front as a line.
 fn accuracy_chart(
     trades: &[accuracy::Trade],
-    scenes: &[accuracy::Scene],
+    scenes: &[accuracy::Workload],
     query: &str,
 ) -> Chart<'static> {
     let mut series = Vec::new();

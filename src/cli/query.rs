@@ -10,8 +10,8 @@ use obbtree::build::BuildOptions;
 use obbtree::experiment::median_time;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    collide_files, distance_files, span_files, within_tolerance_files, BoxTest, CollideOptions,
-    DescentRule, DistanceOptions, Pose, QueryContext, Stats,
+    BoxTest, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, SpanOptions,
+    ToleranceOptions, Witness, Work,
 };
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -213,7 +213,7 @@ fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
     ))
 }
 
-fn stats_json(s: &Stats) -> Value {
+fn work_json(s: &Work) -> Value {
     json!({
         "bv_disjoint": s.bv_disjoint,
         "bv_overlap": s.bv_overlap,
@@ -225,7 +225,7 @@ fn stats_json(s: &Stats) -> Value {
     })
 }
 
-fn stats_text(s: &Stats) -> String {
+fn work_text(s: &Work) -> String {
     format!(
         "D={} I={} S={} K={} nodes visited {}",
         s.bv_disjoint, s.bv_overlap, s.tri_separated, s.tri_contact, s.nodes_visited
@@ -236,25 +236,18 @@ fn point(p: &nalgebra::Vector3<f64>) -> Value {
     json!([p.x, p.y, p.z])
 }
 
-/// The JSON of a distance or span answer: the value under `key`, its witness points (world
-/// frame) and triangles, statistics and query time.
-fn witness_json(
-    key: &str,
-    value: f64,
-    points: [&nalgebra::Vector3<f64>; 2],
-    triangles: [u32; 2],
-    stats: &Stats,
-    seconds: f64,
-) -> Value {
+/// The JSON of a distance or span answer: its distance under `key`, its points (world
+/// frame) and triangles, the work and the query time.
+fn witness_json(key: &str, w: &Witness, work: &Work, seconds: f64) -> Value {
     let mut out = json!({
-        "point_a": point(points[0]),
-        "point_b": point(points[1]),
-        "tri_a": triangles[0],
-        "tri_b": triangles[1],
-        "stats": stats_json(stats),
+        "point_a": point(&w.point_a),
+        "point_b": point(&w.point_b),
+        "tri_a": w.tri_a,
+        "tri_b": w.tri_b,
+        "stats": work_json(work),
         "seconds": seconds,
     });
-    insert(&mut out, key, json!(value));
+    insert(&mut out, key, json!(w.distance));
     out
 }
 
@@ -298,9 +291,14 @@ fn csv_field(value: Option<&Value>) -> String {
 
 /// Runs `query` once, or over the batch in parallel, and prints the answers as text, JSON
 /// or CSV (`columns`, see [`csv_columns`]).
-fn run_query<F>(inputs: &QueryInputs, columns: &[&str], query: F) -> Result<(), Failure>
+fn run_query<F>(
+    inputs: &QueryInputs,
+    (a, b): (&ObbtFile, &ObbtFile),
+    columns: &[&str],
+    query: F,
+) -> Result<(), Failure>
 where
-    F: Fn(&Pose, &Pose, &mut QueryContext) -> Result<Answer, Failure> + Sync,
+    F: Fn(&Pose, &Pose, &mut PairQuery<'_>) -> Result<Answer, Failure> + Sync,
 {
     let batch = inputs.poses.batch()?;
     if inputs.csv {
@@ -323,8 +321,8 @@ where
         }
     };
     let Some(batch) = batch else {
-        let (a, b) = inputs.poses.single()?;
-        let (value, text) = query(&a, &b, &mut QueryContext::new())?;
+        let (pose_a, pose_b) = inputs.poses.single()?;
+        let (value, text) = query(&pose_a, &pose_b, &mut PairQuery::new(a, b)?)?;
         return if inputs.csv {
             print(0, value)
         } else if inputs.json {
@@ -336,9 +334,13 @@ where
     let run = || -> Vec<Result<Value, Failure>> {
         batch
             .par_iter()
-            .map_init(QueryContext::new, |context, (a, b)| {
-                query(a, b, context).map(|(v, _)| v)
-            })
+            .map_init(
+                || PairQuery::new(a, b),
+                |pair, (pa, pb)| match pair {
+                    Ok(pair) => query(pa, pb, pair).map(|(v, _)| v),
+                    Err(e) => Err(e.clone().into()),
+                },
+            )
             .collect()
     };
     let answers = with_threads(inputs.threads, run)?;
@@ -364,16 +366,15 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
     };
     let columns = csv_columns(&["/colliding", "/contacts", "/bv_test_lower_bound"]);
     let repeat = args.inputs.repeat;
-    run_query(&args.inputs, &columns, |pa, pb, context| {
-        let (r, seconds) =
-            median_time(repeat, || collide_files(&a, pa, &b, pb, &options, context))?;
+    run_query(&args.inputs, (&a, &b), &columns, |pa, pb, pair| {
+        let (r, seconds) = median_time(repeat, || pair.collide(pa, pb, &options))?;
         // (A first-contact query finds one contact, not all: no bound applies.)
         let bound = obbtree::experiment::lower_bound(&a, &b, r.pairs.len()).filter(|_| !args.first);
         let mut value = json!({
             "colliding": r.colliding,
             "contacts": r.pairs.len(),
             "bv_test_lower_bound": bound,
-            "stats": stats_json(&r.stats),
+            "stats": work_json(&r.work),
             "seconds": seconds,
         });
         if args.pairs {
@@ -390,7 +391,7 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
             } else {
                 ""
             },
-            stats_text(&r.stats),
+            work_text(&r.work),
             seconds
         );
         if args.pairs {
@@ -423,21 +424,20 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         &["/distance", "/tri_a", "/tri_b"]
     });
     let repeat = args.inputs.repeat;
-    run_query(&args.inputs, &columns, |pa, pb, context| {
+    run_query(&args.inputs, (&a, &b), &columns, |pa, pb, pair| {
         if let Some(t) = args.tolerance {
-            let (r, seconds) = median_time(repeat, || {
-                within_tolerance_files(&a, pa, &b, pb, t, rule, context)
-            })?;
+            let tolerance = ToleranceOptions { tolerance: t, rule };
+            let (r, seconds) = median_time(repeat, || pair.within(pa, pb, &tolerance))?;
             let w = r.witness.as_ref();
             let value = json!({
-                "closer_than_tolerance": r.closer,
+                "closer_than_tolerance": r.closer(),
                 "tolerance": t,
                 "distance": w.map(|w| w.distance),
                 "point_a": w.map(|w| point(&w.point_a)),
                 "point_b": w.map(|w| point(&w.point_b)),
                 "tri_a": w.map(|w| w.tri_a),
                 "tri_b": w.map(|w| w.tri_b),
-                "stats": stats_json(&r.stats),
+                "stats": work_json(&r.work),
                 "seconds": seconds,
             });
             let text = match w {
@@ -446,33 +446,29 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
                     w.tri_a,
                     w.tri_b,
                     number(w.distance),
-                    stats_text(&r.stats)
+                    work_text(&r.work)
                 ),
                 None => format!(
                     "closer than {t}: no ({}) in {seconds:.6} s",
-                    stats_text(&r.stats)
+                    work_text(&r.work)
                 ),
             };
             return Ok((value, text));
         }
-        let (r, seconds) =
-            median_time(repeat, || distance_files(&a, pa, &b, pb, &options, context))?;
-        let value = witness_json(
-            "distance",
-            r.distance,
-            [&r.point_a, &r.point_b],
-            [r.tri_a, r.tri_b],
-            &r.stats,
-            seconds,
-        );
+        let (r, seconds) = median_time(repeat, || pair.distance(pa, pb, &options))?;
+        // Without a maximum distance every query finds a closest pair.
+        let w = r
+            .closest
+            .ok_or_else(|| Failure("no triangle pair reached".into()))?;
+        let value = witness_json("distance", &w, &r.work, seconds);
         let text = format!(
             "distance: {} between triangle {} of A at {:?} and triangle {} of B at {:?} ({}) in {seconds:.6} s",
-            number(r.distance),
-            r.tri_a,
-            r.point_a.as_slice(),
-            r.tri_b,
-            r.point_b.as_slice(),
-            stats_text(&r.stats)
+            number(w.distance),
+            w.tri_a,
+            w.point_a.as_slice(),
+            w.tri_b,
+            w.point_b.as_slice(),
+            work_text(&r.work)
         );
         Ok((value, text))
     })
@@ -480,25 +476,21 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
 
 pub fn span(args: &SpanArgs) -> Result<(), Failure> {
     let (a, b) = open_pair(&args.inputs)?;
-    let rule = args.inputs.rule.rule();
+    let options = SpanOptions {
+        rule: args.inputs.rule.rule(),
+    };
     let columns = csv_columns(&["/span", "/tri_a", "/tri_b"]);
     let repeat = args.inputs.repeat;
-    run_query(&args.inputs, &columns, |pa, pb, context| {
-        let (r, seconds) = median_time(repeat, || span_files(&a, pa, &b, pb, rule, context))?;
-        let value = witness_json(
-            "span",
-            r.span,
-            [&r.point_a, &r.point_b],
-            [r.tri_a, r.tri_b],
-            &r.stats,
-            seconds,
-        );
+    run_query(&args.inputs, (&a, &b), &columns, |pa, pb, pair| {
+        let (r, seconds) = median_time(repeat, || pair.span(pa, pb, &options))?;
+        let w = &r.farthest;
+        let value = witness_json("span", w, &r.work, seconds);
         let text = format!(
             "span: {} between {:?} on A and {:?} on B ({}) in {seconds:.6} s",
-            number(r.span),
-            r.point_a.as_slice(),
-            r.point_b.as_slice(),
-            stats_text(&r.stats)
+            number(w.distance),
+            w.point_a.as_slice(),
+            w.point_b.as_slice(),
+            work_text(&r.work)
         );
         Ok((value, text))
     })

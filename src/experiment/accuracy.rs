@@ -13,8 +13,7 @@ use crate::format::ObbtFile;
 use crate::generate::{lat_long_sphere, PosePair, Rng};
 use crate::mesh::TriMesh;
 use crate::query::{
-    collide_files, distance_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, Pose, QueryContext, QueryError,
+    CollideOptions, DistanceOptions, PairQuery, Pose, QueryError, ToleranceOptions,
 };
 use crate::real::Precision;
 use nalgebra::Vector3;
@@ -22,7 +21,7 @@ use std::collections::BTreeSet;
 
 /// Two models and the poses each query kind is measured at.
 #[derive(Clone, Debug)]
-pub struct Scene {
+pub struct Workload {
     /// Its name in tables and files.
     pub name: String,
     /// Model A.
@@ -37,7 +36,7 @@ pub struct Scene {
 
 /// The sliding spheres (§5.3.1) at 8 separated positions (x from 1.85 to 2.2) and 3
 /// crossing ones (x = 0.5, 1.0, 1.5), both turned at random.
-pub fn spheres(size: Size, seed: u64) -> Result<Scene, ExperimentError> {
+pub fn spheres(size: Size, seed: u64) -> Result<Workload, ExperimentError> {
     let (stacks, slices) = match size {
         Size::Full => (101, 200),
         Size::Quick => (21, 40),
@@ -46,7 +45,7 @@ pub fn spheres(size: Size, seed: u64) -> Result<Scene, ExperimentError> {
     let mut at = |x: f64| turned_pair(&mut rng, Vector3::new(x, 0.0, 0.0));
     let apart = (0..8).map(|i| at(1.85 + 0.05 * f64::from(i))).collect();
     let crossing = [0.5, 1.0, 1.5].map(&mut at).to_vec();
-    Ok(Scene {
+    Ok(Workload {
         name: "spheres".into(),
         a: lat_long_sphere(1.0, stacks, slices)?,
         b: lat_long_sphere(0.8, stacks, slices)?,
@@ -57,7 +56,7 @@ pub fn spheres(size: Size, seed: u64) -> Result<Scene, ExperimentError> {
 
 /// `mesh` against a turned copy of itself: 8 poses with the copy's centre 1.1 bounding-box
 /// diagonals away in random directions, and 3 with it a quarter of a diagonal away.
-pub fn turned_copy(name: &str, mesh: &TriMesh, seed: u64) -> Scene {
+pub fn turned_copy(name: &str, mesh: &TriMesh, seed: u64) -> Workload {
     let (lo, hi) = crate::arr3::bounds(mesh.vertices());
     let diagonal = Vector3::from(crate::arr3::sub(hi, lo)).norm();
     let centre = (Vector3::from(lo) + Vector3::from(hi)) / 2.0;
@@ -74,7 +73,7 @@ pub fn turned_copy(name: &str, mesh: &TriMesh, seed: u64) -> Scene {
     };
     let apart = (0..8).map(|_| at(1.1 * diagonal)).collect();
     let crossing = (0..3).map(|_| at(0.25 * diagonal)).collect();
-    Scene {
+    Workload {
         name: name.into(),
         a: mesh.clone(),
         b: mesh.clone(),
@@ -216,51 +215,38 @@ const ASKS: [Ask; 8] = [
 
 /// Runs every choice on every scene, one query at a time (the times are the point), each
 /// pose's time the median of `repeat` runs.
-pub fn run(scenes: &[Scene], repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
+pub fn run(scenes: &[Workload], repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
     let mut trades = Vec::new();
     for scene in scenes {
-        let mut scene_trades = measure_scene(scene, repeat)?;
-        mark_pareto(&mut scene_trades);
-        trades.extend(scene_trades);
+        let mut trades_of = measure_workload(scene, repeat)?;
+        mark_pareto(&mut trades_of);
+        trades.extend(trades_of);
     }
     Ok(trades)
 }
 
-fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
+fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
     let exact = TreeChoice {
         precision: Precision::F64,
         ..TreeChoice::DEFAULT
     };
     let reference = trees(scene, exact)?;
-    let mut context = QueryContext::new();
+    let mut pair = PairQuery::new(&reference.0, &reference.1)?;
     // The exact f64 answers every choice is held to.
     let mut distances = Vec::new();
     for [pa, pb] in &scene.apart {
-        let r = distance_files(
-            &reference.0,
-            pa,
-            &reference.1,
-            pb,
-            &DistanceOptions::default(),
-            &mut context,
-        )?;
-        distances.push(r.distance);
+        let r = pair.distance(pa, pb, &DistanceOptions::default())?;
+        distances.push(r.distance());
     }
     let mut contacts = Vec::new();
     for [pa, pb] in &scene.crossing {
-        let r = collide_files(
-            &reference.0,
-            pa,
-            &reference.1,
-            pb,
-            &CollideOptions::default(),
-            &mut context,
-        )?;
+        let r = pair.collide(pa, pb, &CollideOptions::default())?;
         contacts.push(r.pairs.into_iter().collect::<BTreeSet<_>>());
     }
     let mut out = Vec::new();
     for choice in tree_choices() {
         let (a, b) = trees(scene, choice)?;
+        let mut pair = PairQuery::new(&a, &b)?;
         let asks: &[Ask] = if matches!(choice.precision, Precision::F32)
             && choice.fit == FitMethod::Hull
             && choice.leaf_size == 1
@@ -281,22 +267,14 @@ fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentErr
                                     rel_err,
                                     ..DistanceOptions::default()
                                 };
-                                let r = distance_files(&a, pa, &b, pb, &options, &mut context)?;
-                                Ok((r.distance, r.stats.bv_tests()))
+                                let r = pair.distance(pa, pb, &options)?;
+                                Ok((r.distance(), r.work.bv_tests()))
                             }
                             Ask::Tolerance(t) => {
-                                let rule = DescentRule::default();
-                                let r = within_tolerance_files(
-                                    &a,
-                                    pa,
-                                    &b,
-                                    pb,
-                                    (1.0 + t) * d,
-                                    rule,
-                                    &mut context,
-                                )?;
+                                let options = ToleranceOptions::new((1.0 + t) * d);
+                                let r = pair.within(pa, pb, &options)?;
                                 let found = r.witness.map_or(f64::INFINITY, |w| w.distance);
-                                Ok((found, r.stats.bv_tests()))
+                                Ok((found, r.work.bv_tests()))
                             }
                         }
                     })?;
@@ -313,10 +291,10 @@ fn measure_scene(scene: &Scene, repeat: u32) -> Result<Vec<Trade>, ExperimentErr
         let mut trade = Trade::new(&scene.name, "collision", choice.flags().join(", "));
         for ([pa, pb], expected) in scene.crossing.iter().zip(&contacts) {
             let ((found, tests), seconds) = median_time(repeat, || -> Result<_, QueryError> {
-                let r = collide_files(&a, pa, &b, pb, &CollideOptions::default(), &mut context)?;
+                let r = pair.collide(pa, pb, &CollideOptions::default())?;
                 Ok((
                     r.pairs.into_iter().collect::<BTreeSet<_>>(),
-                    r.stats.bv_tests(),
+                    r.work.bv_tests(),
                 ))
             })?;
             let differing = found.symmetric_difference(expected).count();
@@ -343,7 +321,7 @@ fn finish(trade: &mut Trade, poses: usize) {
 }
 
 /// Builds both models' trees for `choice`.
-fn trees(scene: &Scene, choice: TreeChoice) -> Result<(ObbtFile, ObbtFile), ExperimentError> {
+fn trees(scene: &Workload, choice: TreeChoice) -> Result<(ObbtFile, ObbtFile), ExperimentError> {
     let options = choice.options();
     Ok((
         build(&scene.a, &options, None)?,

@@ -23,7 +23,7 @@ use crate::bv::BvKind;
 use crate::format::ObbtFile;
 use crate::generate::{GenerateError, PosePair, Rng};
 use crate::mesh::TriMesh;
-use crate::query::{collide_files, BoxTest, CollideOptions, Pose, QueryContext, QueryError, Stats};
+use crate::query::{BoxTest, CollideOptions, PairQuery, Pose, QueryContext, QueryError, Work};
 use crate::real::Precision;
 use crate::stats::LevelStats;
 use nalgebra::Vector3;
@@ -69,11 +69,11 @@ pub enum ExperimentError {
     /// A tree could not be built.
     #[error(transparent)]
     Build(#[from] BuildError),
-    /// A scene's tree could not be built.
-    #[error("scene {scene}: {source}")]
-    Scene {
-        /// The scene's name (a mesh's file name).
-        scene: String,
+    /// A workload's tree could not be built.
+    #[error("scene {workload}: {source}")]
+    Workload {
+        /// The workload's name (a mesh's file name).
+        workload: String,
         /// Why.
         #[source]
         source: BuildError,
@@ -278,7 +278,7 @@ fn measure(jobs: &[Job<'_>], progress: Option<&Progress>) -> Result<Vec<Point>, 
         .enumerate()
         .flat_map(|(j, job)| job.poses.iter().map(move |p| (j, job, p)))
         .collect();
-    let results: Vec<Result<(usize, Stats, usize, f64), QueryError>> = queries
+    let results: Vec<Result<(usize, Work, usize, f64), QueryError>> = queries
         .par_iter()
         .map_init(QueryContext::new, |context, &(j, job, [pa, pb])| {
             let options = CollideOptions {
@@ -289,16 +289,19 @@ fn measure(jobs: &[Job<'_>], progress: Option<&Progress>) -> Result<Vec<Point>, 
                 },
                 ..CollideOptions::default()
             };
+            let mut pair = PairQuery::with_context(job.a, job.b, std::mem::take(context))?;
             let started = Instant::now();
-            let r = collide_files(job.a, pa, job.b, pb, &options, context)?;
+            let r = pair.collide(pa, pb, &options);
             let seconds = started.elapsed().as_secs_f64();
+            *context = pair.into_context();
+            let r = r?;
             if let Some(p) = progress {
                 p.done.fetch_add(1, Ordering::Relaxed);
             }
-            Ok((j, r.stats, r.pairs.len(), seconds))
+            Ok((j, r.work, r.pairs.len(), seconds))
         })
         .collect();
-    let mut sums = vec![(Stats::default(), 0.0f64, Vec::new()); jobs.len()];
+    let mut sums = vec![(Work::default(), 0.0f64, Vec::new()); jobs.len()];
     for result in results {
         let (j, stats, contacts, seconds) = result?;
         let (Some((sum, bound, times)), Some(job)) = (sums.get_mut(j), jobs.get(j)) else {

@@ -8,7 +8,7 @@
 use nalgebra::{Matrix3, SymmetricEigen};
 
 use super::covariance::Sym3;
-use super::frame::{in_plane_axis, Frame};
+use super::frame::{in_plane_axis, Directions};
 use crate::arr3::{cross, norm2, normalize, V3};
 #[cfg(test)]
 use crate::arr3::{scale, sub};
@@ -16,17 +16,17 @@ use crate::arr3::{scale, sub};
 /// Eigenvalues closer than this fraction of the largest one count as equal.
 pub(crate) const TIE_TOLERANCE: f64 = 1e-9;
 
-/// The principal axes of a 3×3 covariance, as a possibly partly free [`Frame`].
+/// The principal axes of a 3×3 covariance, as a possibly partly free [`Directions`].
 ///
 /// Returns `None` when the input is not finite or no solver succeeds.
-pub(crate) fn axes3(c: &Sym3) -> Option<Frame> {
+pub(crate) fn axes3(c: &Sym3) -> Option<Directions> {
     if !c.is_finite() {
         return None;
     }
     // Scaling to unit size makes the tolerances below absolute; eigenvectors are unchanged.
     let s = c.max_abs();
     if s <= 0.0 {
-        return Some(Frame::Free);
+        return Some(Directions::Free);
     }
     let a = Sym3(c.0.map(|v| v / s));
     let (values, vectors) = closed_form(&a).or_else(|| iterative(&a))?;
@@ -34,13 +34,13 @@ pub(crate) fn axes3(c: &Sym3) -> Option<Frame> {
     let [e0, e1, e2] = vectors;
     let tol = TIE_TOLERANCE * l0.abs();
     Some(if l0 - l2 <= tol {
-        Frame::Free
+        Directions::Free
     } else if l0 - l1 <= tol {
-        Frame::FreeBefore { c2: e2 }
+        Directions::FreeBefore { c2: e2 }
     } else if l1 - l2 <= tol {
-        Frame::FreeAfter { c0: e0 }
+        Directions::FreeAfter { c0: e0 }
     } else {
-        Frame::Fixed { c0: e0, c1: e1 }
+        Directions::Fixed { c0: e0, c1: e1 }
     })
 }
 
@@ -169,20 +169,20 @@ fn sym2(a: f64, b: f64, c: f64) -> (f64, f64, [f64; 2]) {
 ///
 /// `(a, b, c)` is the 2×2 covariance `[[a, b], [b, c]]` in the orthonormal in-plane basis
 /// `(u, v)`; `normal = u × v`. The normal is the axis of least (zero) spread, column 2.
-pub(crate) fn axes2(a: f64, b: f64, c: f64, u: V3, v: V3, normal: V3) -> Option<Frame> {
+pub(crate) fn axes2(a: f64, b: f64, c: f64, u: V3, v: V3, normal: V3) -> Option<Directions> {
     if !(a.is_finite() && b.is_finite() && c.is_finite()) {
         return None;
     }
     let (l0, l1, [x, y]) = sym2(a, b, c);
     if l0 - l1 <= TIE_TOLERANCE * l0.abs() {
-        return Some(Frame::FreeBefore { c2: normal });
+        return Some(Directions::FreeBefore { c2: normal });
     }
     let c0 = normalize([
         x * u[0] + y * v[0],
         x * u[1] + y * v[1],
         x * u[2] + y * v[2],
     ])?;
-    Some(Frame::Fixed {
+    Some(Directions::Fixed {
         c0,
         c1: cross(normal, c0),
     })
@@ -273,19 +273,19 @@ mod tests {
         let mut state = 9;
         let (a, r) = with_spectrum([2.0, 2.0, 1.0], &mut state);
         match axes3(&a) {
-            Some(Frame::FreeBefore { c2 }) => assert!(1.0 - dot(c2, r[2]).abs() < 1e-12),
+            Some(Directions::FreeBefore { c2 }) => assert!(1.0 - dot(c2, r[2]).abs() < 1e-12),
             other => panic!("{other:?}"),
         }
         let (a, r) = with_spectrum([3.0, 1.0, 1.0], &mut state);
         match axes3(&a) {
-            Some(Frame::FreeAfter { c0 }) => assert!(1.0 - dot(c0, r[0]).abs() < 1e-12),
+            Some(Directions::FreeAfter { c0 }) => assert!(1.0 - dot(c0, r[0]).abs() < 1e-12),
             other => panic!("{other:?}"),
         }
         let (a, _) = with_spectrum([1.0, 1.0, 1.0], &mut state);
-        assert_eq!(axes3(&a), Some(Frame::Free));
+        assert_eq!(axes3(&a), Some(Directions::Free));
         assert!(matches!(
             axes3(&with_spectrum([3.0, 2.0, 1.0], &mut state).0),
-            Some(Frame::Fixed { .. })
+            Some(Directions::Fixed { .. })
         ));
         assert_eq!(axes3(&Sym3([f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0])), None);
     }

@@ -1,6 +1,6 @@
 //! Turning principal directions into the final right-handed orthonormal frame.
 //!
-//! A [`Frame`] records which columns the covariance determined and which are free (a
+//! A [`Directions`] records which columns the covariance determined and which are free (a
 //! repeated eigenvalue, or the directions across a line). Free columns default to the world
 //! axes projected into the free subspace (Gram–Schmidt), so an axis-aligned cube gets the
 //! identity; [`super::symmetry`] may then pick better ones. [`finish`] fixes signs and
@@ -12,7 +12,7 @@ use crate::arr3::{axis, cross, dot, norm2, normalize, scale, sub, V3};
 
 /// Principal directions, sorted by decreasing spread, with possibly free columns.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Frame {
+pub(crate) enum Directions {
     /// Columns 0 and 1 are determined (column 2 is their cross product).
     Fixed { c0: V3, c1: V3 },
     /// Column 0 is determined; columns 1 and 2 are free in the plane normal to it.
@@ -23,22 +23,22 @@ pub(crate) enum Frame {
     Free,
 }
 
-impl Frame {
+impl Directions {
     /// True when some column is not determined by the covariance.
     pub(crate) fn is_free(&self) -> bool {
-        !matches!(self, Frame::Fixed { .. })
+        !matches!(self, Directions::Fixed { .. })
     }
 
     /// Columns 0 and 1 with free columns set to projected world axes.
     pub(crate) fn default_columns(&self) -> (V3, V3) {
         match *self {
-            Frame::Fixed { c0, c1 } => (c0, c1),
-            Frame::FreeAfter { c0 } => (c0, in_plane_axis(c0)),
-            Frame::FreeBefore { c2 } => {
+            Directions::Fixed { c0, c1 } => (c0, c1),
+            Directions::FreeAfter { c0 } => (c0, in_plane_axis(c0)),
+            Directions::FreeBefore { c2 } => {
                 let c0 = in_plane_axis(c2);
                 (c0, cross(c2, c0))
             }
-            Frame::Free => (axis(0), axis(1)),
+            Directions::Free => (axis(0), axis(1)),
         }
     }
 }

@@ -11,7 +11,7 @@ use nalgebra::Matrix3;
 use super::covariance::{FaceMoment, Moments, Sym3};
 use super::dimension::{classify, classify_with, Shape};
 use super::eigen::{axes2, axes3};
-use super::frame::{finish, Frame};
+use super::frame::{finish, Directions};
 use super::hull::{is_flat, plane_basis};
 use super::scratch::Scratch;
 use super::symmetry::{refine, LargestTriangles};
@@ -58,7 +58,7 @@ pub(crate) fn fit(
     match shape.dim {
         0 => return Matrix3::identity(),
         1 => {
-            let (c0, c1) = Frame::FreeAfter {
+            let (c0, c1) = Directions::FreeAfter {
                 c0: shape.direction,
             }
             .default_columns();
@@ -126,7 +126,7 @@ fn sample(s: &mut Scratch, target: usize) -> Shape {
 }
 
 /// Area covariance of the hull surface (3-D) or polygon (flat), or `None` on failure.
-fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Frame, Source)> {
+fn hull_frame(s: &mut Scratch, shape: &Shape) -> Option<(Directions, Source)> {
     if is_flat(shape) {
         s.hull.polygon(&s.pts, shape);
         let poly = &s.hull.poly;
@@ -193,7 +193,7 @@ fn area_covariance(faces: impl Iterator<Item = FaceMoment>) -> Option<Sym3> {
 
 /// Principal axes of covariance `c`: in the plane for coplanar sets (normal last), else
 /// of the full matrix.
-fn cov_frame(c: &Sym3, shape: &Shape) -> Option<Frame> {
+fn cov_frame(c: &Sym3, shape: &Shape) -> Option<Directions> {
     if shape.dim == 2 {
         let (u, v, n) = plane_basis(shape);
         axes2(c.form(u, u), c.form(u, v), c.form(v, v), u, v, n)

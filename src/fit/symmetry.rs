@@ -12,7 +12,7 @@
 //! This only runs when a tie was detected, so its extra passes over the points do not
 //! matter for speed.
 
-use super::frame::Frame;
+use super::frame::Directions;
 use crate::arr3::{cross, dot, norm2, normalize, scale, sub, V3};
 
 /// How many of the largest triangles propose directions.
@@ -72,7 +72,7 @@ impl LargestTriangles {
 
 /// Columns 0 and 1 for `frame`: its determined columns, with free ones chosen to minimise
 /// the box over `points` among the default and the candidates from `tris`.
-pub(crate) fn refine(frame: &Frame, points: &[V3], tris: &LargestTriangles) -> (V3, V3) {
+pub(crate) fn refine(frame: &Directions, points: &[V3], tris: &LargestTriangles) -> (V3, V3) {
     let default = frame.default_columns();
     if !frame.is_free() {
         return default;
@@ -93,28 +93,28 @@ pub(crate) fn refine(frame: &Frame, points: &[V3], tris: &LargestTriangles) -> (
         };
         let edges = [sub(q, p), sub(r, q), sub(p, r)];
         match *frame {
-            Frame::Free => {
+            Directions::Free => {
                 for e in edges {
                     if let Some(a) = project(e, n) {
                         consider((n, a));
                     }
                 }
             }
-            Frame::FreeAfter { c0 } => {
+            Directions::FreeAfter { c0 } => {
                 for d in [edges[0], edges[1], edges[2], n] {
                     if let Some(a) = project(d, c0) {
                         consider((c0, a));
                     }
                 }
             }
-            Frame::FreeBefore { c2 } => {
+            Directions::FreeBefore { c2 } => {
                 for d in [edges[0], edges[1], edges[2], n] {
                     if let Some(a) = project(d, c2) {
                         consider((a, cross(c2, a)));
                     }
                 }
             }
-            Frame::Fixed { .. } => {}
+            Directions::Fixed { .. } => {}
         }
     }
     best
@@ -131,13 +131,13 @@ fn project(d: V3, w: V3) -> Option<V3> {
 
 /// The measure of the box over `points` in the free columns: the product of the extents
 /// along them (determined columns are common to all candidates, so they cancel).
-fn box_size(frame: &Frame, (c0, c1): (V3, V3), points: &[V3]) -> f64 {
+fn box_size(frame: &Directions, (c0, c1): (V3, V3), points: &[V3]) -> f64 {
     let c2 = cross(c0, c1);
     let axes: &[V3] = match frame {
-        Frame::Free => &[c0, c1, c2],
-        Frame::FreeAfter { .. } => &[c1, c2],
-        Frame::FreeBefore { .. } => &[c0, c1],
-        Frame::Fixed { .. } => &[],
+        Directions::Free => &[c0, c1, c2],
+        Directions::FreeAfter { .. } => &[c1, c2],
+        Directions::FreeBefore { .. } => &[c0, c1],
+        Directions::Fixed { .. } => &[],
     };
     axes.iter()
         .map(|&a| {

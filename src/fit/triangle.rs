@@ -11,7 +11,7 @@ use nalgebra::Matrix3;
 
 use super::dimension::{DIMENSION_TOLERANCE, POINT_TOLERANCE};
 use super::eigen::axes2;
-use super::frame::{finish, Frame};
+use super::frame::{finish, Directions};
 use super::symmetry::{refine, LargestTriangles};
 use crate::arr3;
 use crate::arr3::{cross, dot, norm2, normalize, sub, V3};
@@ -48,7 +48,7 @@ pub(crate) fn triangle_frame(p: V3, q: V3, r: V3) -> Matrix3<f64> {
     let tol = DIMENSION_TOLERANCE * DIMENSION_TOLERANCE * d2;
     let normal = if norm2(n) > tol { normalize(n) } else { None };
     let Some(normal) = normal else {
-        let (c0, c1) = Frame::FreeAfter { c0: u }.default_columns();
+        let (c0, c1) = Directions::FreeAfter { c0: u }.default_columns();
         return finish(c0, c1);
     };
     let v = cross(normal, u);

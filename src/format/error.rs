@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 /// A file or buffer that `open` (the O(1) header and directory checks) refuses, or a view of
 /// the wrong type.
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum FormatError {
     /// Shorter than the fixed header or than the header plus directory it declares.

@@ -7,12 +7,12 @@ use super::layout::{
     ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, PLACEMENT_STRIDE, SECTION_ALIGN,
     SIGNATURE, VERSION_MAJOR,
 };
-use crate::bv::{with_volume_type, BoundingVolume, BvKind, Node};
+use crate::bv::{dispatch, BoundingVolume, BvKind, Node, VolumeVisitor};
 use crate::fit::FitMethod;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
 use crate::stats::{level_stats, LevelStats, TreeShape, TreeStats};
-use crate::tree::{Encoding, TreeView, VARIABLE_MAX_LEAF_FACES};
+use crate::tree::{Encoding, NodeDefect, TreeView, VARIABLE_MAX_LEAF_FACES};
 use std::ops::Range;
 use std::path::Path;
 use zerocopy::{FromBytes, FromZeros};
@@ -132,7 +132,14 @@ pub trait TreeVisitor {
 
 /// The stride of one node record of a given volume and precision (at most 128 bytes).
 fn node_size(bv: BvKind, precision: Precision) -> usize {
-    with_volume_type!(bv, precision, B => Node::<B>::SIZE)
+    struct NodeSize;
+    impl VolumeVisitor for NodeSize {
+        type Output = usize;
+        fn visit<B: BoundingVolume>(self) -> usize {
+            Node::<B>::SIZE
+        }
+    }
+    dispatch(bv, precision, NodeSize)
 }
 
 /// [`SECTION_ALIGN`] as a `usize`, for checking a buffer's address.
@@ -252,11 +259,17 @@ impl ObbtFile {
     /// The tree's volumes measured level by level, root first ([`LevelStats`]). Reads every
     /// node; a damaged, unverified file gives the first defect met.
     pub fn level_stats(&self) -> Result<Vec<LevelStats>, VerifyError> {
+        struct Levels;
+        impl TreeVisitor for Levels {
+            type Output = Result<Vec<LevelStats>, NodeDefect>;
+            fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
+                level_stats(&tree)
+            }
+        }
         let nodes = |problem: String| VerifyError::new("section nodes", problem);
-        with_volume_type!(self.bv_kind(), self.precision(), B => {
-            let view = self.view::<B>().map_err(|e| nodes(e.to_string()))?;
-            level_stats(&view).map_err(|d| nodes(d.to_string()))
-        })
+        self.visit(Levels)
+            .map_err(|e| nodes(e.to_string()))?
+            .map_err(|d| nodes(d.to_string()))
     }
 
     /// Writes the image to `path` atomically (temporary file in the same directory, fsync,
@@ -310,9 +323,19 @@ impl ObbtFile {
 
     /// Runs `visitor` on the tree with its concrete volume type and precision.
     pub fn visit<V: TreeVisitor>(&self, visitor: V) -> Result<V::Output, FormatError> {
-        Ok(with_volume_type!(self.bv_kind(), self.precision(), B => {
-            visitor.visit(self.view::<B>()?)
-        }))
+        /// The file's view typed by [`dispatch`], handed to the tree visitor.
+        struct Typed<'f, V> {
+            file: &'f ObbtFile,
+            visitor: V,
+        }
+        impl<V: TreeVisitor> VolumeVisitor for Typed<'_, V> {
+            type Output = Result<V::Output, FormatError>;
+            fn visit<B: BoundingVolume>(self) -> Self::Output {
+                Ok(self.visitor.visit(self.file.view::<B>()?))
+            }
+        }
+        let file = self;
+        dispatch(self.bv_kind(), self.precision(), Typed { file, visitor })
     }
 
     fn from_backing(backing: Backing) -> Result<ObbtFile, FormatError> {

@@ -2,10 +2,9 @@
 
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangles_intersect, Triangle};
-use super::{source_id, with_views, DescentRule, Pose, QueryError, Side, Stats};
+use super::{source_id, DescentRule, Pose, QueryError, Side, Work};
 use crate::bv::pair::{OFFSET_ROUNDING, SAT_GUARD};
 use crate::bv::BoundingVolume;
-use crate::format::ObbtFile;
 use crate::tree::TreeView;
 use nalgebra::Vector3;
 
@@ -46,8 +45,8 @@ impl Default for CollideOptions {
     }
 }
 
-/// The answer of a collision query (the default is "not colliding", an empty buffer to
-/// pass to `collide_into`).
+/// The answer of a collision query (the default is "not colliding": an empty buffer for
+/// [`super::PairQuery::collide_into`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CollideResult {
     /// Whether any triangle of A touches any triangle of B.
@@ -56,7 +55,7 @@ pub struct CollideResult {
     /// `first_contact`.
     pub pairs: Vec<(u32, u32)>,
     /// Work done.
-    pub stats: Stats,
+    pub work: Work,
 }
 
 struct Collide {
@@ -94,28 +93,26 @@ impl<B: BoundingVolume> Policy<B> for Collide {
     }
 
     #[inline]
-    fn triangles(
-        &mut self,
-        fa: u32,
-        a: &Triangle,
-        fb: u32,
-        b: &Triangle,
-        stats: &mut Stats,
-    ) -> Flow {
+    fn triangles(&mut self, fa: u32, a: &Triangle, fb: u32, b: &Triangle, work: &mut Work) -> Flow {
         if triangles_intersect(a, b) {
-            stats.tri_contact += 1;
+            work.tri_contact += 1;
             self.faces.push((fa, fb));
             if self.first {
                 return Flow::Stop;
             }
         } else {
-            stats.tri_separated += 1;
+            work.tri_separated += 1;
         }
         Flow::Continue
     }
 }
 
-/// All contacting triangle pairs of two posed trees (or the first found).
+/// All contacting triangle pairs of two posed trees (or the first found): what
+/// [`super::PairQuery::collide`] runs once it has typed the trees.
+///
+/// # Errors
+///
+/// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent (an unverified file).
 pub fn collide<B: BoundingVolume>(
     a: &TreeView<'_, B>,
     pose_a: &Pose,
@@ -131,6 +128,10 @@ pub fn collide<B: BoundingVolume>(
 
 /// [`collide`] writing into `result`, whose pair buffer is reused (cleared, not freed), so
 /// that a query per frame allocates nothing once the buffers have grown.
+///
+/// # Errors
+///
+/// As [`collide`].
 pub fn collide_into<B: BoundingVolume>(
     a: &TreeView<'_, B>,
     pose_a: &Pose,
@@ -146,10 +147,10 @@ pub fn collide_into<B: BoundingVolume>(
     if let (Some(ra), Some(rb)) = (a.node(0), b.node(0)) {
         if balls_apart(&ra.bv, &rb.bv, &b_to_a) {
             // The root pair, tested and found disjoint (the boxes lie in the balls).
-            result.stats = Stats {
+            result.work = Work {
                 bv_disjoint: 1,
                 nodes_visited: 1,
-                ..Stats::default()
+                ..Work::default()
             };
             return Ok(());
         }
@@ -164,7 +165,7 @@ pub fn collide_into<B: BoundingVolume>(
     };
     let traversal = traverse(a, b, &b_to_a, options.rule, &mut policy, context);
     context.faces = policy.faces;
-    result.stats = traversal?;
+    result.work = traversal?;
     for &(fa, fb) in &context.faces {
         result
             .pairs
@@ -187,18 +188,4 @@ fn balls_apart<B: BoundingVolume>(a: &B, b: &B, b_to_a: &Pose) -> bool {
     // Mapping B's centre and the difference round by a few ulps of their magnitudes.
     let rounding = OFFSET_ROUNDING * (ca.abs().sum() + cb.abs().sum());
     (cb - ca).norm() > ra + rb + rounding
-}
-
-/// [`collide`] on two files, dispatched once on their volume type and precision.
-pub fn collide_files(
-    a: &ObbtFile,
-    pose_a: &Pose,
-    b: &ObbtFile,
-    pose_b: &Pose,
-    options: &CollideOptions,
-    context: &mut QueryContext,
-) -> Result<CollideResult, QueryError> {
-    with_views!(a, b, |va, vb| collide(
-        &va, pose_a, &vb, pose_b, options, context
-    ))
 }

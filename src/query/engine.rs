@@ -8,8 +8,8 @@
 //! and children must follow their parents, so every traversal terminates.
 
 use super::descent::DescentRule;
-use super::stats::Stats;
 use super::triangle::Triangle;
+use super::work::Work;
 use super::{QueryError, Side};
 use crate::bv::{BoundingVolume, Node};
 use crate::pose::Pose;
@@ -60,7 +60,7 @@ pub(crate) trait Policy<B: BoundingVolume> {
         a: &Triangle,
         face_b: u32,
         b: &Triangle,
-        stats: &mut Stats,
+        work: &mut Work,
     ) -> Flow;
 }
 
@@ -252,7 +252,7 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     rule: DescentRule,
     policy: &mut P,
     context: &mut QueryContext,
-) -> Result<Stats, QueryError> {
+) -> Result<Work, QueryError> {
     if P::ORDERED {
         let mut frontier = Frontier {
             heap: &mut context.heap,
@@ -300,8 +300,8 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
     rule: DescentRule,
     policy: &mut P,
     waiting: &mut W,
-) -> Result<Stats, QueryError> {
-    let mut stats = Stats::default();
+) -> Result<Work, QueryError> {
+    let mut work = Work::default();
     // A tree visits each node pair at most once; more means shared children (a corrupt,
     // unverified file), which could otherwise take exponential time.
     let limit = (a.nodes().len() as u64).saturating_mul(b.nodes().len() as u64);
@@ -316,8 +316,8 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
             break;
         };
         let (ia, ib, key) = (pending.a(), pending.b(), pending.key());
-        stats.nodes_visited += 1;
-        if stats.nodes_visited > limit {
+        work.nodes_visited += 1;
+        if work.nodes_visited > limit {
             return Err(QueryError::CorruptTree {
                 which: Side::A,
                 what: "a node is reachable along two paths",
@@ -331,18 +331,18 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
             policy.key(&na.bv, &nb.bv, b_to_a)
         };
         if !policy.keep(key) {
-            stats.bv_disjoint += 1;
+            work.bv_disjoint += 1;
             if P::ORDERED && smallest {
                 // The smallest key waiting is pruned, so is every other: they were all
                 // tested when pushed, and count as pruned pairs taken off.
                 let rest = waiting.len() as u64;
-                stats.bv_disjoint += rest;
-                stats.nodes_visited += rest;
+                work.bv_disjoint += rest;
+                work.nodes_visited += rest;
                 break;
             }
             continue;
         }
-        stats.bv_overlap += 1;
+        work.bv_overlap += 1;
         let kind_a = a.node_kind(ia).map_err(|d| corrupt(Side::A, d))?;
         let kind_b = b.node_kind(ib).map_err(|d| corrupt(Side::B, d))?;
         // The tree a step descends, and its node's children.
@@ -352,8 +352,8 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                     let ta = triangle(a, fa, None, Side::A)?;
                     for fb in faces_b.clone() {
                         let tb = triangle(b, fb, Some(b_to_a), Side::B)?;
-                        if policy.triangles(fa, &ta, fb, &tb, &mut stats) == Flow::Stop {
-                            return Ok(stats);
+                        if policy.triangles(fa, &ta, fb, &tb, &mut work) == Flow::Stop {
+                            return Ok(work);
                         }
                     }
                 }
@@ -385,9 +385,9 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 other: ia,
             },
         };
-        dive = push_children(&step, b_to_a, policy, waiting, &mut stats)?;
+        dive = push_children(&step, b_to_a, policy, waiting, &mut work)?;
     }
-    Ok(stats)
+    Ok(work)
 }
 
 /// One step of a traversal: `side`'s node is descended into its `children` (nodes of
@@ -488,7 +488,7 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
     b_to_a: &Pose,
     policy: &P,
     waiting: &mut impl Waiting,
-    stats: &mut Stats,
+    work: &mut Work,
 ) -> Result<Option<Pending>, QueryError> {
     // (Wider nodes, of the variable encoding, keep the order below.)
     if !P::ORDERED && policy.nearest_first() && step.children.len() == 2 {
@@ -511,8 +511,8 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
         };
         let (key, rank) = (ordered_key(key), ordered_key(rank));
         if !policy.keep(key) {
-            stats.nodes_visited += 1;
-            stats.bv_disjoint += 1;
+            work.nodes_visited += 1;
+            work.bv_disjoint += 1;
             continue;
         }
         let pair = step.pair(c, key);

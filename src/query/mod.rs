@@ -5,43 +5,45 @@
 //! collide with it (as in RAPID, PQP and FCL). Poses are f64 whatever the stored precision;
 //! triangle ids in every result are the input mesh's ids.
 //!
+//! [`PairQuery`] is the one way in: made once per pair of models, it answers collision
+//! ([`PairQuery::collide`]), distance ([`PairQuery::distance`]), tolerance
+//! ([`PairQuery::within`]) and span ([`PairQuery::span`]), each taking the two poses and
+//! its options and returning its answer with the [`Work`] it did. [`details`] holds the
+//! same queries as generic functions over typed tree views.
+//!
 //! ```no_run
 //! use obbtree::format::ObbtFile;
-//! use obbtree::query::{collide_files, CollideOptions, Pose, QueryContext};
+//! use obbtree::query::{CollideOptions, PairQuery, Pose};
 //!
 //! let a = ObbtFile::open("bunny.obbt")?;
 //! let b = ObbtFile::open("cow.obbt")?;
-//! let mut context = QueryContext::new();
-//! let result = collide_files(&a, &Pose::identity(), &b, &Pose::translation(0.1, 0.0, 0.0), &CollideOptions::default(), &mut context)?;
-//! println!("{} contacts, {:?}", result.pairs.len(), result.stats);
+//! let mut pair = PairQuery::new(&a, &b)?;
+//! let at = Pose::translation(0.1, 0.0, 0.0);
+//! let result = pair.collide(&Pose::identity(), &at, &CollideOptions::default())?;
+//! println!("{} contacts, {:?}", result.pairs.len(), result.work);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 mod collide;
 mod descent;
+pub mod details;
 mod distance;
 mod engine;
 mod pair_query;
 mod span;
-mod stats;
 pub mod triangle;
+mod work;
 
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
-pub use collide::{collide, collide_files, collide_into, BoxTest, CollideOptions, CollideResult};
+pub use collide::{BoxTest, CollideOptions, CollideResult};
 pub use descent::DescentRule;
 pub use distance::{
-    distance, distance_below, distance_files, within_tolerance, within_tolerance_files,
-    DistanceOptions, DistanceResult, ToleranceResult, Witness,
+    DistanceOptions, DistanceResult, ToleranceOptions, ToleranceResult, WarmStart, Witness,
 };
 pub use engine::QueryContext;
 pub use pair_query::PairQuery;
-pub use span::{span, span_files, SpanResult};
-pub use stats::Stats;
-
-use crate::bv::{Aabb, BvKind, Obb, Sphere};
-use crate::format::ObbtFile;
-use crate::real::Precision;
-use crate::tree::TreeView;
+pub use span::{SpanOptions, SpanResult};
+pub use work::Work;
 
 /// One of the two models of a pair query: A, in whose frame results are given, or B.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -91,94 +93,10 @@ pub enum QueryError {
         /// The value given.
         value: f64,
     },
-    /// A view of a tree could not be made.
-    #[error("{0}")]
-    Format(String),
+    /// A file's sections could not be viewed as a tree.
+    #[error(transparent)]
+    Format(#[from] crate::format::FormatError),
 }
-
-/// Typed views of two files of the same volume type and precision: the one place a pair
-/// of files is dispatched on its header tags ([`ViewPair::of`]), and the one match that
-/// runs generic code on it ([`on_views!`]). A [`PairQuery`] makes it once, since typing a
-/// file's sections costs about 20 ns, a sixth of a query culled at the roots.
-#[derive(Clone, Copy)]
-pub(crate) enum ViewPair<'f> {
-    // (Variants named for the volume type and precision both views have.)
-    ObbF32(TreeView<'f, Obb<f32>>, TreeView<'f, Obb<f32>>),
-    ObbF64(TreeView<'f, Obb<f64>>, TreeView<'f, Obb<f64>>),
-    AabbF32(TreeView<'f, Aabb<f32>>, TreeView<'f, Aabb<f32>>),
-    AabbF64(TreeView<'f, Aabb<f64>>, TreeView<'f, Aabb<f64>>),
-    SphereF32(TreeView<'f, Sphere<f32>>, TreeView<'f, Sphere<f32>>),
-    SphereF64(TreeView<'f, Sphere<f64>>, TreeView<'f, Sphere<f64>>),
-}
-
-impl<'f> ViewPair<'f> {
-    /// The views of `a` and `b`; an error if they store different volume types or
-    /// precisions, or a section cannot be viewed.
-    pub(crate) fn of(a: &'f ObbtFile, b: &'f ObbtFile) -> Result<ViewPair<'f>, QueryError> {
-        if (a.bv_kind(), a.precision()) != (b.bv_kind(), b.precision()) {
-            return Err(QueryError::MismatchedTrees {
-                a: format!("{} {}", a.bv_kind().name(), a.precision().name()),
-                b: format!("{} {}", b.bv_kind().name(), b.precision().name()),
-            });
-        }
-        let fmt = |e: crate::format::FormatError| QueryError::Format(e.to_string());
-        Ok(match (a.bv_kind(), a.precision()) {
-            (BvKind::Obb, Precision::F32) => {
-                ViewPair::ObbF32(a.view().map_err(fmt)?, b.view().map_err(fmt)?)
-            }
-            (BvKind::Obb, Precision::F64) => {
-                ViewPair::ObbF64(a.view().map_err(fmt)?, b.view().map_err(fmt)?)
-            }
-            (BvKind::Aabb, Precision::F32) => {
-                ViewPair::AabbF32(a.view().map_err(fmt)?, b.view().map_err(fmt)?)
-            }
-            (BvKind::Aabb, Precision::F64) => {
-                ViewPair::AabbF64(a.view().map_err(fmt)?, b.view().map_err(fmt)?)
-            }
-            (BvKind::Sphere, Precision::F32) => {
-                ViewPair::SphereF32(a.view().map_err(fmt)?, b.view().map_err(fmt)?)
-            }
-            (BvKind::Sphere, Precision::F64) => {
-                ViewPair::SphereF64(a.view().map_err(fmt)?, b.view().map_err(fmt)?)
-            }
-        })
-    }
-}
-
-impl std::fmt::Debug for ViewPair<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        on_views!(self, |va, vb| f
-            .debug_struct("ViewPair")
-            .field("a_nodes", &va.nodes().len())
-            .field("b_nodes", &vb.nodes().len())
-            .finish())
-    }
-}
-
-/// Runs `$body` with `$va`, `$vb` bound to the typed views of a [`ViewPair`].
-macro_rules! on_views {
-    ($pair:expr, |$va:ident, $vb:ident| $body:expr) => {{
-        use $crate::query::ViewPair;
-        match $pair {
-            ViewPair::ObbF32($va, $vb) => $body,
-            ViewPair::ObbF64($va, $vb) => $body,
-            ViewPair::AabbF32($va, $vb) => $body,
-            ViewPair::AabbF64($va, $vb) => $body,
-            ViewPair::SphereF32($va, $vb) => $body,
-            ViewPair::SphereF64($va, $vb) => $body,
-        }
-    }};
-}
-pub(crate) use on_views;
-
-/// Runs `$body` with `$va`, `$vb` bound to typed views of two files of the same volume type
-/// and precision ([`ViewPair::of`], then [`on_views!`]).
-macro_rules! with_views {
-    ($a:expr, $b:expr, |$va:ident, $vb:ident| $body:expr) => {{
-        $crate::query::on_views!($crate::query::ViewPair::of($a, $b)?, |$va, $vb| $body)
-    }};
-}
-pub(crate) use with_views;
 
 /// The input-mesh id of leaf-ordered face `face`.
 pub(crate) fn source_id<B: crate::bv::BoundingVolume>(

@@ -1,21 +1,29 @@
-//! Two trees queried together many times, with the poses per call.
+//! Two trees queried together many times, with the poses per call: the query API.
 
+use super::details;
 use super::{
-    collide_into, distance, distance_below, on_views, span, within_tolerance, CollideOptions,
-    CollideResult, DescentRule, DistanceOptions, DistanceResult, Pose, QueryContext, QueryError,
-    SpanResult, Stats, ToleranceResult, ViewPair,
+    CollideOptions, CollideResult, DistanceOptions, DistanceResult, Pose, QueryContext, QueryError,
+    SpanOptions, SpanResult, ToleranceOptions, ToleranceResult,
 };
+use crate::bv::{dispatch, BoundingVolume, VolumeVisitor};
 use crate::format::ObbtFile;
+use crate::tree::TreeView;
 
 /// Model A and model B, checked once to be queryable together, with the traversal scratch
-/// kept between queries: the per-frame object of an application (the free functions such
-/// as [`super::collide_files`] take six positional arguments, where A and B are easy to
-/// swap).
+/// kept between queries: the one way to query a pair of models.
 ///
-/// Results can be written into buffers the caller keeps ([`PairQuery::collide_into`]), so
-/// a query per frame allocates nothing once the buffers have grown. For a yes/no answer per
-/// frame use [`PairQuery::first_contact`]: it stops at the first contact and is typically
-/// tens to hundreds of times faster than listing every contact.
+/// Every query takes A's pose, B's pose and its options, and returns its answer with the
+/// [`super::Work`] it did; results are in the world frame, triangle ids are the input
+/// meshes'. The volume type and precision the files store are dispatched once, in
+/// [`PairQuery::new`]; a query then costs one indirect call more than the typed functions
+/// of [`details`].
+///
+/// For a yes/no answer per frame ask for [`CollideOptions::first_contact`]: it stops at
+/// the first contact and is typically tens to hundreds of times faster than listing every
+/// contact. [`PairQuery::collide_into`] writes into a buffer the caller keeps, so a query
+/// per frame allocates nothing once the buffer has grown.
+///
+/// # Examples
 ///
 /// ```no_run
 /// use obbtree::format::ObbtFile;
@@ -23,37 +31,75 @@ use crate::format::ObbtFile;
 ///
 /// let gripper = ObbtFile::open("gripper.obbt")?;
 /// let part = ObbtFile::open("part.obbt")?;
-/// let mut query = PairQuery::new(&gripper, &part)?;
+/// let mut pair = PairQuery::new(&gripper, &part)?;
+/// let first = CollideOptions { first_contact: true, ..CollideOptions::default() };
 /// for step in 0..100 {
 ///     let at = Pose::translation(0.01 * f64::from(step), 0.0, 0.0);
-///     if let Some((tri_gripper, tri_part)) = query.first_contact(&at, &Pose::identity())? {
+///     if let Some((tri_gripper, tri_part)) = pair.collide(&at, &Pose::identity(), &first)?.pairs.first() {
 ///         println!("step {step}: triangle {tri_gripper} touches {tri_part}");
 ///     }
 /// }
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Debug)]
 pub struct PairQuery<'f> {
     a: &'f ObbtFile,
     b: &'f ObbtFile,
-    /// The typed views of A and B, made once (each query would otherwise make them again).
-    views: ViewPair<'f>,
+    /// The typed views of A and B, made once (typing a file's sections per query would
+    /// cost a good part of a query culled at the roots).
+    trees: Box<dyn TypedPair + Send + Sync + 'f>,
     context: QueryContext,
-    /// The pair buffer of first-contact queries, kept so that a yes/no query per frame
-    /// allocates nothing.
-    first: CollideResult,
+}
+
+impl std::fmt::Debug for PairQuery<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PairQuery")
+            .field("a", &self.a.info().bv)
+            .field("b", &self.b.info().bv)
+            .field("precision", &self.a.precision())
+            .finish_non_exhaustive()
+    }
 }
 
 impl<'f> PairQuery<'f> {
-    /// The pair (A, B); an error if they store different volume types or precisions.
+    /// The pair (A, B).
+    ///
+    /// # Errors
+    ///
+    /// [`QueryError::MismatchedTrees`] if the files store different volume types or
+    /// precisions; [`QueryError::Format`] if a file's sections cannot be viewed.
     pub fn new(a: &'f ObbtFile, b: &'f ObbtFile) -> Result<PairQuery<'f>, QueryError> {
+        PairQuery::with_context(a, b, QueryContext::new())
+    }
+
+    /// [`PairQuery::new`] with the traversal scratch of an earlier pair
+    /// ([`PairQuery::into_context`]): a program that queries many short-lived pairs (a
+    /// scene's narrow phase) keeps one scratch per thread and allocates nothing per pair.
+    ///
+    /// # Errors
+    ///
+    /// As [`PairQuery::new`].
+    pub fn with_context(
+        a: &'f ObbtFile,
+        b: &'f ObbtFile,
+        context: QueryContext,
+    ) -> Result<PairQuery<'f>, QueryError> {
+        if (a.bv_kind(), a.precision()) != (b.bv_kind(), b.precision()) {
+            return Err(QueryError::MismatchedTrees {
+                a: format!("{} {}", a.bv_kind().name(), a.precision().name()),
+                b: format!("{} {}", b.bv_kind().name(), b.precision().name()),
+            });
+        }
         Ok(PairQuery {
             a,
             b,
-            views: ViewPair::of(a, b)?,
-            context: QueryContext::new(),
-            first: CollideResult::default(),
+            trees: dispatch(a.bv_kind(), a.precision(), Typing { a, b })?,
+            context,
         })
+    }
+
+    /// The traversal scratch, for [`PairQuery::with_context`].
+    pub fn into_context(self) -> QueryContext {
+        self.context
     }
 
     /// Model A.
@@ -66,7 +112,12 @@ impl<'f> PairQuery<'f> {
         self.b
     }
 
-    /// Every contacting triangle pair (or the first, with `options.first_contact`).
+    /// Every contacting triangle pair, sorted (or the first one found, with
+    /// [`CollideOptions::first_contact`]).
+    ///
+    /// # Errors
+    ///
+    /// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent (an unverified file).
     pub fn collide(
         &mut self,
         pose_a: &Pose,
@@ -79,6 +130,10 @@ impl<'f> PairQuery<'f> {
     }
 
     /// [`PairQuery::collide`] into `result`, reusing its pair buffer.
+    ///
+    /// # Errors
+    ///
+    /// As [`PairQuery::collide`].
     pub fn collide_into(
         &mut self,
         pose_a: &Pose,
@@ -87,89 +142,154 @@ impl<'f> PairQuery<'f> {
         result: &mut CollideResult,
     ) -> Result<(), QueryError> {
         let context = &mut self.context;
-        on_views!(self.views, |va, vb| collide_into(
-            &va, pose_a, &vb, pose_b, options, context, result
-        ))
+        self.trees
+            .collide_into(pose_a, pose_b, options, context, result)
     }
 
-    /// The first contacting pair found (input-mesh ids of A's and B's triangles), or
-    /// `None` when the models do not touch: the cheapest yes/no collision answer.
-    pub fn first_contact(
-        &mut self,
-        pose_a: &Pose,
-        pose_b: &Pose,
-    ) -> Result<Option<(u32, u32)>, QueryError> {
-        Ok(self.first_contact_stats(pose_a, pose_b)?.0)
-    }
-
-    /// [`PairQuery::first_contact`] with the work done.
-    pub fn first_contact_stats(
-        &mut self,
-        pose_a: &Pose,
-        pose_b: &Pose,
-    ) -> Result<(Option<(u32, u32)>, Stats), QueryError> {
-        let options = CollideOptions {
-            first_contact: true,
-            ..CollideOptions::default()
-        };
-        let mut result = std::mem::take(&mut self.first);
-        let outcome = self.collide_into(pose_a, pose_b, &options, &mut result);
-        let answer = (result.pairs.first().copied(), result.stats);
-        self.first = result;
-        outcome.map(|()| answer)
-    }
-
-    /// The distance, exact or within the errors of `options`.
+    /// The distance between the surfaces with its closest points, exact or within the
+    /// errors of `options`, up to [`DistanceOptions::max_distance`].
+    ///
+    /// # Errors
+    ///
+    /// [`QueryError::BadOption`] for an error allowance or maximum distance out of range;
+    /// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
     pub fn distance(
         &mut self,
         pose_a: &Pose,
         pose_b: &Pose,
         options: &DistanceOptions,
     ) -> Result<DistanceResult, QueryError> {
-        let context = &mut self.context;
-        on_views!(self.views, |va, vb| distance(
-            &va, pose_a, &vb, pose_b, options, context
-        ))
+        self.trees
+            .distance(pose_a, pose_b, options, &mut self.context)
     }
 
-    /// The distance if it is below `limit`, else `None` (see [`distance_below`]).
-    pub fn distance_below(
+    /// Whether the surfaces come closer than [`ToleranceOptions::tolerance`], stopping as
+    /// soon as it knows.
+    ///
+    /// # Errors
+    ///
+    /// [`QueryError::BadOption`] for a negative or non-finite tolerance;
+    /// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
+    pub fn within(
         &mut self,
         pose_a: &Pose,
         pose_b: &Pose,
-        options: &DistanceOptions,
-        limit: f64,
-    ) -> Result<(Option<DistanceResult>, Stats), QueryError> {
-        let context = &mut self.context;
-        on_views!(self.views, |va, vb| distance_below(
-            &va, pose_a, &vb, pose_b, options, limit, context
-        ))
-    }
-
-    /// Whether the models come closer than `tolerance`, stopping as soon as it knows.
-    pub fn within_tolerance(
-        &mut self,
-        pose_a: &Pose,
-        pose_b: &Pose,
-        tolerance: f64,
-        rule: DescentRule,
+        options: &ToleranceOptions,
     ) -> Result<ToleranceResult, QueryError> {
-        let context = &mut self.context;
-        on_views!(self.views, |va, vb| within_tolerance(
-            &va, pose_a, &vb, pose_b, tolerance, rule, context
-        ))
+        self.trees
+            .within(pose_a, pose_b, options, &mut self.context)
     }
 
-    /// The span (largest distance) between the models.
+    /// The span: the largest distance between a point of A and a point of B.
+    ///
+    /// # Errors
+    ///
+    /// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
     pub fn span(
         &mut self,
         pose_a: &Pose,
         pose_b: &Pose,
-        rule: DescentRule,
+        options: &SpanOptions,
     ) -> Result<SpanResult, QueryError> {
-        let context = &mut self.context;
-        on_views!(self.views, |va, vb| span(
-            &va, pose_a, &vb, pose_b, rule, context
-        ))
+        self.trees.span(pose_a, pose_b, options, &mut self.context)
+    }
+}
+
+/// The queries of [`details`] on two typed views, behind one indirect call.
+trait TypedPair {
+    fn collide_into(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &CollideOptions,
+        context: &mut QueryContext,
+        result: &mut CollideResult,
+    ) -> Result<(), QueryError>;
+    fn distance(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &DistanceOptions,
+        context: &mut QueryContext,
+    ) -> Result<DistanceResult, QueryError>;
+    fn within(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &ToleranceOptions,
+        context: &mut QueryContext,
+    ) -> Result<ToleranceResult, QueryError>;
+    fn span(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &SpanOptions,
+        context: &mut QueryContext,
+    ) -> Result<SpanResult, QueryError>;
+}
+
+/// A's and B's trees typed as volume `B`.
+struct Views<'f, B: BoundingVolume> {
+    a: TreeView<'f, B>,
+    b: TreeView<'f, B>,
+}
+
+impl<B: BoundingVolume> TypedPair for Views<'_, B> {
+    fn collide_into(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &CollideOptions,
+        context: &mut QueryContext,
+        result: &mut CollideResult,
+    ) -> Result<(), QueryError> {
+        details::collide_into(&self.a, pose_a, &self.b, pose_b, options, context, result)
+    }
+
+    fn distance(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &DistanceOptions,
+        context: &mut QueryContext,
+    ) -> Result<DistanceResult, QueryError> {
+        details::distance(&self.a, pose_a, &self.b, pose_b, options, context)
+    }
+
+    fn within(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &ToleranceOptions,
+        context: &mut QueryContext,
+    ) -> Result<ToleranceResult, QueryError> {
+        details::within(&self.a, pose_a, &self.b, pose_b, options, context)
+    }
+
+    fn span(
+        &self,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        options: &SpanOptions,
+        context: &mut QueryContext,
+    ) -> Result<SpanResult, QueryError> {
+        details::span(&self.a, pose_a, &self.b, pose_b, options, context)
+    }
+}
+
+/// Types both files' views as the volume type they store (checked equal by the caller).
+struct Typing<'f> {
+    a: &'f ObbtFile,
+    b: &'f ObbtFile,
+}
+
+impl<'f> VolumeVisitor for Typing<'f> {
+    type Output = Result<Box<dyn TypedPair + Send + Sync + 'f>, QueryError>;
+
+    fn visit<B: BoundingVolume>(self) -> Self::Output {
+        Ok(Box::new(Views::<'f, B> {
+            a: self.a.view()?,
+            b: self.b.view()?,
+        }))
     }
 }

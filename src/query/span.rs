@@ -2,27 +2,32 @@
 
 use super::engine::{traverse, Flow, Policy, QueryContext};
 use super::triangle::{triangle_max_distance, Triangle};
-use super::{source_id, with_views, DescentRule, Pose, QueryError, Side, Stats};
+use super::{source_id, DescentRule, Pose, QueryError, Side, Witness, Work};
 use crate::bv::BoundingVolume;
-use crate::format::ObbtFile;
 use crate::tree::TreeView;
 use nalgebra::Vector3;
+
+/// How to run a span query.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SpanOptions {
+    /// Which tree to descend when both can be.
+    pub rule: DescentRule,
+}
 
 /// The answer of a span query.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpanResult {
-    /// The largest distance between the two surfaces, world units (attained at vertices).
-    pub span: f64,
-    /// Witness on A, world frame.
-    pub point_a: Vector3<f64>,
-    /// Witness on B, world frame.
-    pub point_b: Vector3<f64>,
-    /// Input-mesh id of a triangle of A holding `point_a`.
-    pub tri_a: u32,
-    /// Input-mesh id of a triangle of B holding `point_b`.
-    pub tri_b: u32,
+    /// The farthest pair: its distance is the span, attained at vertices.
+    pub farthest: Witness,
     /// Work done.
-    pub stats: Stats,
+    pub work: Work,
+}
+
+impl SpanResult {
+    /// The largest distance between a point of A and a point of B, world units.
+    pub fn span(&self) -> f64 {
+        self.farthest.distance
+    }
 }
 
 struct Span {
@@ -47,16 +52,9 @@ impl<B: BoundingVolume> Policy<B> for Span {
     }
 
     #[inline]
-    fn triangles(
-        &mut self,
-        fa: u32,
-        a: &Triangle,
-        fb: u32,
-        b: &Triangle,
-        stats: &mut Stats,
-    ) -> Flow {
+    fn triangles(&mut self, fa: u32, a: &Triangle, fb: u32, b: &Triangle, work: &mut Work) -> Flow {
         let d = triangle_max_distance(a, b);
-        stats.tri_separated += 1;
+        work.tri_separated += 1;
         if d.distance > self.best {
             *self = Span {
                 best: d.distance,
@@ -69,13 +67,18 @@ impl<B: BoundingVolume> Policy<B> for Span {
     }
 }
 
-/// The span (maximum distance) between two posed trees, with witness points.
+/// The span (largest distance) between two posed trees, with its witness points: what
+/// [`super::PairQuery::span`] runs once it has typed the trees.
+///
+/// # Errors
+///
+/// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent (an unverified file).
 pub fn span<B: BoundingVolume>(
     a: &TreeView<'_, B>,
     pose_a: &Pose,
     b: &TreeView<'_, B>,
     pose_b: &Pose,
-    rule: DescentRule,
+    options: &SpanOptions,
     context: &mut QueryContext,
 ) -> Result<SpanResult, QueryError> {
     let b_to_a = Pose::relative(pose_a, pose_b);
@@ -85,7 +88,7 @@ pub fn span<B: BoundingVolume>(
         point_b: Vector3::zeros(),
         faces: (0, 0),
     };
-    let stats = traverse(a, b, &b_to_a, rule, &mut policy, context)?;
+    let work = traverse(a, b, &b_to_a, options.rule, &mut policy, context)?;
     if policy.best < 0.0 {
         return Err(QueryError::CorruptTree {
             which: Side::A,
@@ -93,23 +96,13 @@ pub fn span<B: BoundingVolume>(
         });
     }
     Ok(SpanResult {
-        span: policy.best,
-        point_a: pose_a.apply(&policy.point_a),
-        point_b: pose_a.apply(&policy.point_b),
-        tri_a: source_id(a, policy.faces.0, Side::A)?,
-        tri_b: source_id(b, policy.faces.1, Side::B)?,
-        stats,
+        farthest: Witness {
+            distance: policy.best,
+            point_a: pose_a.apply(&policy.point_a),
+            point_b: pose_a.apply(&policy.point_b),
+            tri_a: source_id(a, policy.faces.0, Side::A)?,
+            tri_b: source_id(b, policy.faces.1, Side::B)?,
+        },
+        work,
     })
-}
-
-/// [`span`] on two files, dispatched once on their volume type and precision.
-pub fn span_files(
-    a: &ObbtFile,
-    pose_a: &Pose,
-    b: &ObbtFile,
-    pose_b: &Pose,
-    rule: DescentRule,
-    context: &mut QueryContext,
-) -> Result<SpanResult, QueryError> {
-    with_views!(a, b, |va, vb| span(&va, pose_a, &vb, pose_b, rule, context))
 }

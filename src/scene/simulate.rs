@@ -10,8 +10,8 @@ use super::rules::{Effect, Reach, RuleTable};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::query::{
-    collide, distance, distance_below, span, with_views, within_tolerance, CollideOptions,
-    DescentRule, DistanceOptions, Pose, QueryContext, QueryError, Side, Stats, Witness,
+    CollideOptions, DistanceOptions, PairQuery, Pose, QueryContext, QueryError, Side, SpanOptions,
+    ToleranceOptions, WarmStart, Work,
 };
 use crate::tree::TreeView;
 use rayon::prelude::*;
@@ -223,7 +223,7 @@ struct PairState {
     /// The stamp (frame + 1) of the last narrow answer, `None` once culled.
     answered: Option<u64>,
     /// The last distance answer's triangle pair, to warm-start the next.
-    witness: Option<Witness>,
+    warm_start: Option<WarmStart>,
 }
 
 /// A narrow query to run.
@@ -231,15 +231,16 @@ struct PairState {
 struct Job {
     pair: (u32, u32),
     effect: Effect,
-    warm: Option<Witness>,
+    warm_start: Option<WarmStart>,
 }
 
 /// A narrow query's result.
 #[derive(Clone, Debug)]
 struct Outcome {
     answer: Option<Answer>,
-    witness: Option<Witness>,
-    stats: Stats,
+    /// The distance answer's triangle pair, to warm-start the next.
+    warm_start: Option<WarmStart>,
+    work: Work,
     early_exit: bool,
     /// Time the query took.
     seconds: f64,
@@ -353,7 +354,7 @@ impl Scene {
                     effect,
                     answer,
                     answered: None,
-                    witness: None,
+                    warm_start: None,
                 },
             );
         }
@@ -473,10 +474,10 @@ impl Scene {
                 effect: job.effect,
                 answer: None,
                 answered: None,
-                witness: None,
+                warm_start: None,
             });
             state.answered = Some(stamp);
-            state.witness = outcome.witness.or(state.witness);
+            state.warm_start = outcome.warm_start.or(state.warm_start);
             let before = state.answer.take();
             set_answer(
                 &mut self.listed,
@@ -548,7 +549,7 @@ impl Scene {
             jobs.push(Job {
                 pair,
                 effect,
-                warm: state.and_then(|s| s.witness),
+                warm_start: state.and_then(|s| s.warm_start),
             });
         }
         // Deterministic order (the overlap set is a hash set).
@@ -567,7 +568,7 @@ impl Scene {
                     jobs.push(Job {
                         pair: (i as u32, j as u32),
                         effect,
-                        warm: None,
+                        warm_start: None,
                     });
                 }
             }
@@ -580,13 +581,13 @@ impl Scene {
         if let Some(work) = s.narrow.of(&job.effect) {
             work.add(&EffectWork {
                 queries: 1,
-                box_tests: outcome.stats.bv_tests(),
-                triangle_tests: outcome.stats.tri_separated + outcome.stats.tri_contact,
+                box_tests: outcome.work.bv_tests(),
+                triangle_tests: outcome.work.tri_separated + outcome.work.tri_contact,
                 seconds: outcome.seconds,
             });
         }
         s.early_exits += u64::from(outcome.early_exit);
-        s.warm_starts += u64::from(job.warm.is_some() && !self.naive);
+        s.warm_starts += u64::from(job.warm_start.is_some() && !self.naive);
     }
 }
 
@@ -650,96 +651,103 @@ fn run_job(
         return Err(missing);
     };
     let (pa, pb) = (&a.pose, &b.pose);
-    with_views!(&*a.asset, &*b.asset, |va, vb| {
-        let rule = DescentRule::default();
-        let outcome = |answer, witness, stats, early_exit| Outcome {
-            answer,
-            witness,
-            stats,
-            early_exit,
-            seconds: 0.0,
-        };
-        let exact = DistanceOptions::default();
-        Ok(match (job.effect, naive) {
-            (Effect::None, _) => outcome(None, None, Stats::default(), false),
-            (Effect::Contact, false) => {
-                let first = CollideOptions {
-                    first_contact: true,
-                    ..CollideOptions::default()
-                };
-                let r = collide(&va, pa, &vb, pb, &first, context)?;
-                let answer = r.colliding.then_some(Answer::Contact);
-                outcome(answer, None, r.stats, r.colliding)
-            }
-            (Effect::Contact | Effect::Contacts, _) => {
-                let r = collide(&va, pa, &vb, pb, &CollideOptions::default(), context)?;
-                let answer = match job.effect {
-                    Effect::Contact => r.colliding.then_some(Answer::Contact),
-                    _ => r.colliding.then_some(Answer::Contacts(r.pairs)),
-                };
-                outcome(answer, None, r.stats, false)
-            }
-            (Effect::Clearance { clearance }, false) => {
-                let r = within_tolerance(&va, pa, &vb, pb, clearance, rule, context)?;
-                let answer = r.witness.map(|w| Answer::Closer {
+    let mut pair = PairQuery::with_context(&a.asset, &b.asset, std::mem::take(context))?;
+    let outcome = narrow(&mut pair, pa, pb, job, naive);
+    *context = pair.into_context();
+    outcome
+}
+
+/// The query that answers `job`'s effect on `pair` at poses `pa`, `pb`: the cheapest that
+/// answers it, or (naive) the full exact one.
+fn narrow(
+    pair: &mut PairQuery<'_>,
+    pa: &Pose,
+    pb: &Pose,
+    job: &Job,
+    naive: bool,
+) -> Result<Outcome, QueryError> {
+    let outcome = |answer, warm_start, work, early_exit| Outcome {
+        answer,
+        warm_start,
+        work,
+        early_exit,
+        seconds: 0.0,
+    };
+    let exact = DistanceOptions::default();
+    Ok(match (job.effect, naive) {
+        (Effect::None, _) => outcome(None, None, Work::default(), false),
+        (Effect::Contact, false) => {
+            let first = CollideOptions {
+                first_contact: true,
+                ..CollideOptions::default()
+            };
+            let r = pair.collide(pa, pb, &first)?;
+            let answer = r.colliding.then_some(Answer::Contact);
+            outcome(answer, None, r.work, r.colliding)
+        }
+        (Effect::Contact | Effect::Contacts, _) => {
+            let r = pair.collide(pa, pb, &CollideOptions::default())?;
+            let answer = match job.effect {
+                Effect::Contact => r.colliding.then_some(Answer::Contact),
+                _ => r.colliding.then_some(Answer::Contacts(r.pairs)),
+            };
+            outcome(answer, None, r.work, false)
+        }
+        (Effect::Clearance { clearance }, false) => {
+            let r = pair.within(pa, pb, &ToleranceOptions::new(clearance))?;
+            let answer = r.witness.map(|w| Answer::Closer {
+                tri_a: w.tri_a,
+                tri_b: w.tri_b,
+                distance: w.distance,
+            });
+            outcome(answer, None, r.work, r.closer())
+        }
+        (Effect::Clearance { clearance }, true) => {
+            let r = pair.distance(pa, pb, &exact)?;
+            let answer = r
+                .closest
+                .filter(|w| w.distance < clearance)
+                .map(|w| Answer::Closer {
                     tri_a: w.tri_a,
                     tri_b: w.tri_b,
                     distance: w.distance,
                 });
-                outcome(answer, None, r.stats, r.closer)
-            }
-            (Effect::Clearance { clearance }, true) => {
-                let r = distance(&va, pa, &vb, pb, &exact, context)?;
-                let answer = (r.distance < clearance).then_some(Answer::Closer {
-                    tri_a: r.tri_a,
-                    tri_b: r.tri_b,
-                    distance: r.distance,
-                });
-                outcome(answer, None, r.stats, false)
-            }
-            (
-                Effect::Distance {
+            outcome(answer, None, r.work, false)
+        }
+        (
+            Effect::Distance {
+                rel_err,
+                max_distance,
+            },
+            _,
+        ) => {
+            // The naive run measures exactly and compares with the maximum afterwards.
+            let options = if naive {
+                exact
+            } else {
+                DistanceOptions {
                     rel_err,
-                    max_distance,
-                },
-                _,
-            ) => {
-                let options = if naive {
-                    exact
-                } else {
-                    DistanceOptions {
-                        rel_err,
-                        warm_start: job.warm,
-                        ..DistanceOptions::default()
-                    }
-                };
-                let measured = |r: &crate::query::DistanceResult| Answer::Distance {
-                    distance: r.distance,
-                    tri_a: r.tri_a,
-                    tri_b: r.tri_b,
-                };
-                match max_distance {
-                    Some(limit) if !naive => {
-                        let (r, stats) =
-                            distance_below(&va, pa, &vb, pb, &options, limit, context)?;
-                        let far = r.is_none();
-                        let witness = r.as_ref().map(|r| r.witness);
-                        let answer = r.as_ref().map_or(Answer::Far, measured);
-                        outcome(Some(answer), witness, stats, far)
-                    }
-                    _ => {
-                        let r = distance(&va, pa, &vb, pb, &options, context)?;
-                        let far = max_distance.is_some_and(|limit| r.distance >= limit);
-                        let answer = if far { Answer::Far } else { measured(&r) };
-                        outcome(Some(answer), Some(r.witness), r.stats, false)
-                    }
+                    max_distance: max_distance.unwrap_or(f64::INFINITY),
+                    warm_start: job.warm_start,
+                    ..DistanceOptions::default()
                 }
-            }
-            (Effect::Span, _) => {
-                let r = span(&va, pa, &vb, pb, rule, context)?;
-                outcome(Some(Answer::Span(r.span)), None, r.stats, false)
-            }
-        })
+            };
+            let r = pair.distance(pa, pb, &options)?;
+            let closest = r
+                .closest
+                .filter(|w| max_distance.is_none_or(|m| w.distance < m));
+            let answer = closest.map_or(Answer::Far, |w| Answer::Distance {
+                distance: w.distance,
+                tri_a: w.tri_a,
+                tri_b: w.tri_b,
+            });
+            let beyond = !naive && r.closest.is_none();
+            outcome(Some(answer), r.warm_start, r.work, beyond)
+        }
+        (Effect::Span, _) => {
+            let r = pair.span(pa, pb, &SpanOptions::default())?;
+            outcome(Some(Answer::Span(r.span())), None, r.work, false)
+        }
     })
 }
 

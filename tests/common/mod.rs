@@ -197,3 +197,39 @@ pub fn file_triangles(file: &obbtree::format::ObbtFile) -> Vec<(u32, [[f64; 3]; 
     }
     file.visit(Faces).expect("a view of the file's own type")
 }
+
+/// Generic code on the typed views of two files of one volume type and precision: how the
+/// tests reach [`obbtree::query::details`], the queries over typed views.
+pub trait ViewsVisitor {
+    /// What the visit returns.
+    type Output;
+    /// Called once, with both files viewed as their stored volume type `B`.
+    fn visit<B: obbtree::bv::BoundingVolume>(
+        self,
+        a: &obbtree::tree::TreeView<'_, B>,
+        b: &obbtree::tree::TreeView<'_, B>,
+    ) -> Self::Output;
+}
+
+/// Runs `visitor` on the typed views of `a` and `b`, which must store the same volume type
+/// and precision and be viewable.
+pub fn with_views<V: ViewsVisitor>(
+    a: &obbtree::format::ObbtFile,
+    b: &obbtree::format::ObbtFile,
+    visitor: V,
+) -> V::Output {
+    struct Typed<'f, V> {
+        a: &'f obbtree::format::ObbtFile,
+        b: &'f obbtree::format::ObbtFile,
+        visitor: V,
+    }
+    impl<V: ViewsVisitor> obbtree::bv::VolumeVisitor for Typed<'_, V> {
+        type Output = V::Output;
+        fn visit<B: obbtree::bv::BoundingVolume>(self) -> V::Output {
+            let a = self.a.view::<B>().expect("a view of A's own type");
+            let b = self.b.view::<B>().expect("B stores A's type");
+            self.visitor.visit(&a, &b)
+        }
+    }
+    obbtree::bv::dispatch(a.bv_kind(), a.precision(), Typed { a, b, visitor })
+}

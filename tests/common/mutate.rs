@@ -10,8 +10,8 @@ use obbtree::format::layout::{Field, Header, SectionEntry, ENTRY_SIZE, HEADER_SI
 use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::query::triangle::Triangle;
 use obbtree::query::{
-    collide_files, distance_files, span_files, within_tolerance_files, CollideOptions, DescentRule,
-    DistanceOptions, Pose, QueryContext,
+    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, QueryError, SpanOptions,
+    ToleranceOptions,
 };
 
 /// A library [`Field`] as (name, byte offset, width in bytes).
@@ -249,7 +249,6 @@ pub fn exercise(bytes: &[u8], partner: &ObbtFile, poses: &Poses, check_answers: 
     outcome.opened = true;
     let _ = file.info();
     let id = Pose::identity();
-    let mut context = QueryContext::new();
     let mut count = |ok: bool| {
         if ok {
             outcome.answered += 1;
@@ -263,17 +262,35 @@ pub fn exercise(bytes: &[u8], partner: &ObbtFile, poses: &Poses, check_answers: 
     };
     let all = CollideOptions::default();
     let (d, rule) = (DistanceOptions::default(), DescentRule::default());
-    let c = &mut context;
-    count(collide_files(&file, &id, &file, &poses.collide, &all, c).is_ok());
-    count(collide_files(&file, &id, partner, &poses.span, &first, c).is_ok());
-    count(distance_files(&file, &id, &file, &poses.distance, &d, c).is_ok());
-    count(distance_files(partner, &id, &file, &poses.collide, &d, c).is_ok());
-    let t = poses.tolerance;
-    count(within_tolerance_files(&file, &id, &file, &poses.distance, t, rule, c).is_ok());
-    count(span_files(&file, &id, &file, &poses.span, rule, c).is_ok());
+    // A file whose sections cannot be viewed is refused by every query (when its pair is
+    // made).
+    let mut itself = PairQuery::new(&file, &file);
+    let mut with_partner = PairQuery::new(&file, partner);
+    let mut partner_first = PairQuery::new(partner, &file);
+    count(answers(&mut itself, |p| {
+        p.collide(&id, &poses.collide, &all)
+    }));
+    count(answers(&mut with_partner, |p| {
+        p.collide(&id, &poses.span, &first)
+    }));
+    count(answers(&mut itself, |p| {
+        p.distance(&id, &poses.distance, &d)
+    }));
+    count(answers(&mut partner_first, |p| {
+        p.distance(&id, &poses.collide, &d)
+    }));
+    let t = ToleranceOptions {
+        tolerance: poses.tolerance,
+        rule,
+    };
+    count(answers(&mut itself, |p| p.within(&id, &poses.distance, &t)));
+    count(answers(&mut itself, |p| {
+        p.span(&id, &poses.span, &SpanOptions { rule })
+    }));
     outcome.verified = file.verify().is_ok();
     if outcome.verified && check_answers {
-        let got = collide_files(&file, &id, &file, &poses.collide, &all, c)
+        let got = itself
+            .and_then(|mut p| p.collide(&id, &poses.collide, &all))
             .expect("a verified file answers");
         let expected = brute_force_pairs(&file, &id, &file, &poses.collide);
         assert_eq!(
@@ -282,6 +299,14 @@ pub fn exercise(bytes: &[u8], partner: &ObbtFile, poses: &Poses, check_answers: 
         );
     }
     outcome
+}
+
+/// Whether `query` answers on `pair` (a pair that could not be made answers nothing).
+fn answers<T>(
+    pair: &mut Result<PairQuery<'_>, QueryError>,
+    query: impl FnOnce(&mut PairQuery<'_>) -> Result<T, QueryError>,
+) -> bool {
+    pair.as_mut().is_ok_and(|p| query(p).is_ok())
 }
 
 /// Every contacting pair of two posed files by the brute-force oracle over the files' own

@@ -94,8 +94,8 @@ fn precedes(a: &Triangle, b: &Triangle) -> bool {
 
 #[inline(always)]
 fn distance_ordered(a: &Triangle, b: &Triangle) -> TriangleDistance {
-    let fa = Frame::new(a);
-    let fb = Frame::new(b);
+    let fa = Prepared::new(a);
+    let fb = Prepared::new(b);
     if aabb_overlap(a, b) && intersect_with_planes(a, b, &fa.plane, &fb.plane) {
         return contact(&fa, &fb);
     }
@@ -133,7 +133,7 @@ pub fn triangle_max_distance(a: &Triangle, b: &Triangle) -> TriangleDistance {
 }
 
 /// A triangle with the quantities every candidate needs.
-struct Frame<'t> {
+struct Prepared<'t> {
     v: &'t Triangle,
     /// The plane (exact side tests) and its normal `n`.
     plane: PlaneSide,
@@ -147,13 +147,13 @@ struct Frame<'t> {
     nn: f64,
 }
 
-impl<'t> Frame<'t> {
+impl<'t> Prepared<'t> {
     #[inline(always)]
     fn new(v: &'t Triangle) -> Self {
         let plane = PlaneSide::new(v);
         let e = [plane.e1, v[2] - v[1], -plane.e2];
         let n = plane.n;
-        Frame {
+        Prepared {
             v,
             plane,
             e,
@@ -176,7 +176,7 @@ impl<'t> Frame<'t> {
         &self.v[i]
     }
 
-    /// Edge `i`, `v[i + 1] - v[i]` (`i < 3`, see [`Frame::corner`]).
+    /// Edge `i`, `v[i + 1] - v[i]` (`i < 3`, see [`Prepared::corner`]).
     #[inline(always)]
     // why: `i < 3` at every call, see `corner`.
     #[allow(clippy::indexing_slicing)]
@@ -184,7 +184,7 @@ impl<'t> Frame<'t> {
         &self.e[i]
     }
 
-    /// `|edge(i)|²` (`i < 3`, see [`Frame::corner`]).
+    /// `|edge(i)|²` (`i < 3`, see [`Prepared::corner`]).
     #[inline(always)]
     // why: `i < 3` at every call, see `corner`.
     #[allow(clippy::indexing_slicing)]
@@ -333,7 +333,7 @@ impl Best {
 /// both lie within the segments. Uses the cross-product form `s = ((q - p) × d2)·n / |n|²`,
 /// `n = d1 × d2`, which avoids the cancellation of the textbook `a e - b²` denominator.
 #[inline(always)]
-fn edge_edge_interior(fa: &Frame, i: usize, fb: &Frame, j: usize, best: &mut Best) {
+fn edge_edge_interior(fa: &Prepared, i: usize, fb: &Prepared, j: usize, best: &mut Best) {
     let d1 = fa.edge(i);
     let d2 = fb.edge(j);
     let n = d1.cross(d2);
@@ -368,7 +368,7 @@ fn edge_edge_interior(fa: &Frame, i: usize, fb: &Frame, j: usize, best: &mut Bes
 /// - otherwise (degenerate or rounding-limited cases, about 1 in 5000 random pairs) the
 ///   minimum over all 33 candidates.
 #[inline]
-fn separated(fa: &Frame, fb: &Frame) -> Best {
+fn separated(fa: &Prepared, fb: &Prepared) -> Best {
     // Edge pairs, those next to the corners that reach furthest toward the other triangle
     // (along the line between the centroids) first: the closest features usually are there.
     let dir = (fb.v[0] + fb.v[1] + fb.v[2]) - (fa.v[0] + fa.v[1] + fa.v[2]);
@@ -412,7 +412,7 @@ const EDGE_PAIR_ORDER: [(usize, usize); 9] = [
 
 /// Phase 1: `o`'s corners against `f`'s face. `swapped`: `f` is the second triangle.
 #[inline(always)]
-fn corner_face_exit(f: &Frame, o: &Frame, swapped: bool) -> Option<Best> {
+fn corner_face_exit(f: &Prepared, o: &Prepared, swapped: bool) -> Option<Best> {
     if f.nn <= 0.0 {
         return None;
     }
@@ -457,7 +457,7 @@ fn argmin3(s: [f64; 3]) -> usize {
 /// the convex quadratic, with the unconstrained solution in cross-product form), returned when
 /// the third corners certify them as the global minimum.
 #[inline(always)]
-fn edge_edge_exit(fa: &Frame, i: usize, fb: &Frame, j: usize) -> Option<Best> {
+fn edge_edge_exit(fa: &Prepared, i: usize, fb: &Prepared, j: usize) -> Option<Best> {
     let (p, d1, dd1) = (fa.corner(i), fa.edge(i), fa.edge_len2(i));
     let (q, d2, dd2) = (fb.corner(j), fb.edge(j), fb.edge_len2(j));
     let w = q - p; // separation: w + d2 t - d1 s
@@ -512,7 +512,7 @@ fn edge_edge_exit(fa: &Frame, i: usize, fb: &Frame, j: usize) -> Option<Best> {
 /// Phase 3: minimum over the whole decomposition (18 corner–edge, 9 edge–edge interior and
 /// 6 corner–face candidates); exact distance when the triangles are disjoint.
 #[inline(never)]
-fn separated_full(fa: &Frame, fb: &Frame) -> Best {
+fn separated_full(fa: &Prepared, fb: &Prepared) -> Best {
     let (a, b) = (fa.v, fb.v);
     let mut best = Best::new(a[0], b[0]);
     // Corner–edge pairs (they include every corner–corner pair): the boundary of each
@@ -556,7 +556,7 @@ fn separated_full(fa: &Frame, fb: &Frame) -> Best {
 /// degenerate contacts by the best of all candidates. The best pair's midpoint is returned for
 /// both points.
 #[cold]
-fn contact(fa: &Frame, fb: &Frame) -> TriangleDistance {
+fn contact(fa: &Prepared, fb: &Prepared) -> TriangleDistance {
     let mid = |best: &Best| best.pa + (best.pb - best.pa) * 0.5;
     let done = |m: V| TriangleDistance {
         distance: 0.0,
@@ -591,7 +591,7 @@ fn contact(fa: &Frame, fb: &Frame) -> TriangleDistance {
 
 /// Where edge `i` of `s` meets the plane of `t`, if it does at a single point.
 #[inline]
-fn edge_plane_crossing(s: &Frame, i: usize, t: &Frame) -> Option<V> {
+fn edge_plane_crossing(s: &Prepared, i: usize, t: &Prepared) -> Option<V> {
     if t.nn <= 0.0 {
         return None;
     }
@@ -643,7 +643,7 @@ mod tests {
             } else {
                 rng.tri(c, 0.1)
             };
-            let (fa, fb) = (Frame::new(&a), Frame::new(&b));
+            let (fa, fb) = (Prepared::new(&a), Prepared::new(&b));
             if aabb_overlap(&a, &b) && intersect_with_planes(&a, &b, &fa.plane, &fb.plane) {
                 continue;
             }

@@ -1,4 +1,4 @@
-//! Statistics every query returns (dissertation §2.5.1).
+//! The work every query reports (dissertation §2.5.1): volume and triangle tests, node pairs.
 
 /// Work done by one query.
 ///
@@ -6,7 +6,7 @@
 /// `1 = D − I + 2S + 2K` (§2.5.1): every overlapping internal pair spawns two pair tests and
 /// every overlapping leaf pair one triangle test.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Stats {
+pub struct Work {
     /// D: bounding-volume pair tests that pruned the pair (disjoint, or too far / too near
     /// to matter for a distance or span query).
     pub bv_disjoint: u64,
@@ -23,7 +23,7 @@ pub struct Stats {
     pub nodes_visited: u64,
 }
 
-impl Stats {
+impl Work {
     /// Bounding-volume pair tests, `D + I`.
     pub fn bv_tests(&self) -> u64 {
         self.bv_disjoint + self.bv_overlap
