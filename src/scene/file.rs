@@ -20,9 +20,10 @@
 //! # max_distance = 0.5           # optional for distance
 //! ```
 
+use super::builder::{Item, SceneBuilder};
 use super::error::{line_of, SceneError};
 use super::rules::Effect;
-use super::simulate::{Item, Scene, SceneBuilder};
+use super::simulate::Scene;
 use crate::build::{build, BuildOptions};
 use crate::format::layout::SIGNATURE;
 use crate::format::ObbtFile;

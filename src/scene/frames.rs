@@ -1,8 +1,9 @@
 //! Frames as JSON Lines, streamed: `{"poses": {"link2": [12 numbers], ...}}` per line.
 
 use super::error::SceneError;
+use super::frame::Frame;
 use super::report::ObjectId;
-use super::simulate::{Frame, Scene};
+use super::simulate::Scene;
 use crate::query::PoseFormat;
 use rustc_hash::FxHashMap;
 use serde::Deserialize;

@@ -26,6 +26,18 @@ pub enum Effect {
     Span,
 }
 
+/// A rule: pairs of an object matched by `a` and one matched by `b` (in either order) get
+/// `effect`. A side is an object name, a group name, or `*` (every object).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rule {
+    /// First side.
+    pub a: String,
+    /// Second side.
+    pub b: String,
+    /// What the pairs ask for.
+    pub effect: Effect,
+}
+
 /// How near two objects must be for an effect to need the narrow phase.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Reach {

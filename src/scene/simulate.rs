@@ -1,218 +1,20 @@
 //! The scene: objects posed over frames, and the scheduler that gives each pair exactly
 //! the answer its effect asks for, with the least work that answer needs.
 
-use super::broad::{Bounds, SweepAndPrune};
+use super::broad::SweepAndPrune;
 use super::error::SceneError;
+use super::frame::Frame;
+use super::narrow::{run_job, Job, Outcome};
+use super::object::{inflated_bounds, SceneObject};
 use super::report::{
     Answer, EffectWork, Event, EventKind, FrameReport, ObjectId, PairReport, Summary,
 };
-use super::rules::{Effect, Reach, RuleTable};
-use crate::bv::BoundingVolume;
-use crate::format::{ObbtFile, TreeVisitor};
-use crate::query::{
-    collide, distance, distance_below, span, with_views, within_tolerance, CollideOptions,
-    DescentRule, DistanceOptions, Pose, QueryContext, QueryError, Side, Stats, Witness,
-};
-use crate::tree::TreeView;
+use super::rules::{Effect, Reach, Rule, RuleTable};
+use crate::query::{QueryContext, QueryError, Witness};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::collections::BTreeSet;
-use std::sync::Arc;
 use std::time::Instant;
-
-/// One object of a scene: a name, the tree it uses (shared with other objects of the same
-/// asset), its groups and its current pose.
-#[derive(Clone, Debug)]
-pub struct SceneObject {
-    /// Unique name, `[A-Za-z0-9_.-]+`.
-    pub name: String,
-    /// Groups it belongs to (same characters).
-    pub groups: Vec<String>,
-    /// Its tree.
-    pub asset: Arc<ObbtFile>,
-    /// Where it is now.
-    pub pose: Pose,
-}
-
-/// A rule: pairs of an object matched by `a` and one matched by `b` (in either order) get
-/// `effect`. A side is an object name, a group name, or `*` (every object).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Rule {
-    /// First side.
-    pub a: String,
-    /// Second side.
-    pub b: String,
-    /// What the pairs ask for.
-    pub effect: Effect,
-}
-
-/// Which item of a scene description a problem is about, for locating it in a file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Item {
-    Object(usize),
-    Rule(usize),
-}
-
-/// A problem found while building a scene, before it is placed in a file.
-#[derive(Clone, Debug)]
-pub(crate) struct Problem {
-    pub(crate) item: Item,
-    pub(crate) field: &'static str,
-    pub(crate) message: String,
-}
-
-impl Problem {
-    /// As a located error: `rule 3, field a: ...` in `source`, at `line` when known.
-    pub(crate) fn located(self, source: &str, line: Option<usize>) -> SceneError {
-        let item = match self.item {
-            Item::Object(k) => format!("object {}, field {}", k + 1, self.field),
-            Item::Rule(k) => format!("rule {}, field {}", k + 1, self.field),
-        };
-        let e = SceneError::new(source, self.message).in_field(item);
-        match line {
-            Some(line) => e.at_line(line),
-            None => e,
-        }
-    }
-}
-
-/// Collects objects and rules, then checks them into a [`Scene`].
-#[derive(Clone, Debug, Default)]
-pub struct SceneBuilder {
-    objects: Vec<SceneObject>,
-    rules: Vec<Rule>,
-}
-
-/// Whether `name` is a valid object or group name.
-fn valid_name(name: &str) -> bool {
-    !name.is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '-'))
-}
-
-impl SceneBuilder {
-    /// An empty scene description.
-    pub fn new() -> SceneBuilder {
-        SceneBuilder::default()
-    }
-
-    /// Adds an object; its id is its position in the order of addition.
-    pub fn object(
-        &mut self,
-        name: &str,
-        asset: Arc<ObbtFile>,
-        groups: &[&str],
-        pose: Pose,
-    ) -> ObjectId {
-        self.objects.push(SceneObject {
-            name: name.to_owned(),
-            groups: groups.iter().map(|g| (*g).to_owned()).collect(),
-            asset,
-            pose,
-        });
-        self.objects.len() - 1
-    }
-
-    /// Adds a rule; later rules override earlier ones for the pairs both match.
-    pub fn rule(&mut self, a: &str, b: &str, effect: Effect) {
-        self.rules.push(Rule {
-            a: a.to_owned(),
-            b: b.to_owned(),
-            effect,
-        });
-    }
-
-    /// Checks the description and builds the scene at its start poses.
-    pub fn build(self) -> Result<Scene, SceneError> {
-        self.checked().map_err(|p| p.located("scene", None))
-    }
-
-    pub(crate) fn checked(self) -> Result<Scene, Problem> {
-        let problem = |item, field, message: String| Problem {
-            item,
-            field,
-            message,
-        };
-        let mut names: FxHashMap<&str, usize> = FxHashMap::default();
-        for (k, o) in self.objects.iter().enumerate() {
-            if !valid_name(&o.name) {
-                let m = format!("{:?} is not a name of letters, digits, _ . -", o.name);
-                return Err(problem(Item::Object(k), "name", m));
-            }
-            if let Some(first) = names.insert(&o.name, k) {
-                let m = format!("{:?} is also object {}", o.name, first + 1);
-                return Err(problem(Item::Object(k), "name", m));
-            }
-            if let Some(g) = o.groups.iter().find(|g| !valid_name(g)) {
-                let m = format!("{g:?} is not a name of letters, digits, _ . -");
-                return Err(problem(Item::Object(k), "groups", m));
-            }
-        }
-        // One volume type and precision for the whole scene.
-        if let Some(first) = self.objects.first() {
-            let kind = |o: &SceneObject| (o.asset.bv_kind(), o.asset.precision());
-            if let Some((k, other)) = self
-                .objects
-                .iter()
-                .enumerate()
-                .find(|(_, o)| kind(o) != kind(first))
-            {
-                let describe = |o: &SceneObject| {
-                    format!(
-                        "{} {}",
-                        o.asset.bv_kind().name(),
-                        o.asset.precision().name()
-                    )
-                };
-                let m = format!(
-                    "object {:?} stores {} but {:?} stores {}; a scene's assets share one volume type and precision",
-                    other.name,
-                    describe(other),
-                    first.name,
-                    describe(first)
-                );
-                return Err(problem(Item::Object(k), "asset", m));
-            }
-        }
-        let known = |selector: &str| {
-            selector == "*"
-                || names.contains_key(selector)
-                || self
-                    .objects
-                    .iter()
-                    .any(|o| o.groups.iter().any(|g| g == selector))
-        };
-        for (k, r) in self.rules.iter().enumerate() {
-            for (field, side) in [("a", &r.a), ("b", &r.b)] {
-                if !known(side) {
-                    let m = format!("no object or group named {side:?}");
-                    return Err(problem(Item::Rule(k), field, m));
-                }
-            }
-            let positive = |v: f64| v.is_finite() && v > 0.0;
-            match r.effect {
-                Effect::Clearance { clearance } if !positive(clearance) => {
-                    let m = format!("must be a finite number > 0, got {clearance}");
-                    return Err(problem(Item::Rule(k), "clearance", m));
-                }
-                Effect::Distance { rel_err, .. } if !(rel_err.is_finite() && rel_err >= 0.0) => {
-                    let m = format!("must be a finite number >= 0, got {rel_err}");
-                    return Err(problem(Item::Rule(k), "rel_err", m));
-                }
-                Effect::Distance {
-                    max_distance: Some(limit),
-                    ..
-                } if !positive(limit) => {
-                    let m = format!("must be a finite number > 0, got {limit}");
-                    return Err(problem(Item::Rule(k), "max_distance", m));
-                }
-                _ => {}
-            }
-        }
-        Ok(Scene::new(self.objects, self.rules))
-    }
-}
 
 /// What the scheduler keeps of a pair between frames.
 #[derive(Clone, Debug)]
@@ -224,25 +26,6 @@ struct PairState {
     answered: Option<u64>,
     /// The last distance answer's triangle pair, to warm-start the next.
     witness: Option<Witness>,
-}
-
-/// A narrow query to run.
-#[derive(Clone, Copy, Debug)]
-struct Job {
-    pair: (u32, u32),
-    effect: Effect,
-    warm: Option<Witness>,
-}
-
-/// A narrow query's result.
-#[derive(Clone, Debug)]
-struct Outcome {
-    answer: Option<Answer>,
-    witness: Option<Witness>,
-    stats: Stats,
-    early_exit: bool,
-    /// Time the query took.
-    seconds: f64,
 }
 
 /// Many objects moving over frames, each pair of objects with the effect its rules give
@@ -281,20 +64,9 @@ pub struct Scene {
     summary: Summary,
 }
 
-/// The world box of a tree's root volume under a pose.
-struct RootBounds<'p>(&'p Pose);
-
-impl TreeVisitor for RootBounds<'_> {
-    type Output = Option<Bounds>;
-    fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Option<Bounds> {
-        let root = tree.node(0)?;
-        let b = root.bv.world_aabb(self.0);
-        Some([b.min, b.max])
-    }
-}
-
 impl Scene {
-    fn new(objects: Vec<SceneObject>, rules: Vec<Rule>) -> Scene {
+    /// The scene of checked `objects` and `rules`, at the objects' poses.
+    pub(super) fn new(objects: Vec<SceneObject>, rules: Vec<Rule>) -> Scene {
         let matches = |rule: usize, side_b: bool, object: usize| {
             let (Some(r), Some(o)) = (rules.get(rule), objects.get(object)) else {
                 return false;
@@ -617,148 +389,4 @@ fn set_answer(
         listed.remove(&pair);
     }
     state.answer = answer;
-}
-
-/// An object's world box, inflated by `margin` on every side; an empty box far away for an
-/// object whose tree has no root (a damaged file: it can then meet nothing).
-fn inflated_bounds(object: Option<&SceneObject>, margin: Option<f64>) -> Bounds {
-    let far = [[f64::INFINITY; 3], [f64::INFINITY; 3]];
-    let Some(object) = object else { return far };
-    let Ok(Some(b)) = object.asset.visit(RootBounds(&object.pose)) else {
-        return far;
-    };
-    let m = margin.unwrap_or(0.0);
-    [b[0].map(|v| v - m), b[1].map(|v| v + m)]
-}
-
-/// Runs one narrow query: the cheapest that answers the effect, or (naive) the full exact
-/// one.
-fn run_job(
-    job: &Job,
-    objects: &[SceneObject],
-    naive: bool,
-    context: &mut QueryContext,
-) -> Result<Outcome, QueryError> {
-    let missing = QueryError::CorruptTree {
-        which: Side::A,
-        what: "no such object",
-    };
-    let (Some(a), Some(b)) = (
-        objects.get(job.pair.0 as usize),
-        objects.get(job.pair.1 as usize),
-    ) else {
-        return Err(missing);
-    };
-    let (pa, pb) = (&a.pose, &b.pose);
-    with_views!(&*a.asset, &*b.asset, |va, vb| {
-        let rule = DescentRule::default();
-        let outcome = |answer, witness, stats, early_exit| Outcome {
-            answer,
-            witness,
-            stats,
-            early_exit,
-            seconds: 0.0,
-        };
-        let exact = DistanceOptions::default();
-        Ok(match (job.effect, naive) {
-            (Effect::None, _) => outcome(None, None, Stats::default(), false),
-            (Effect::Contact, false) => {
-                let first = CollideOptions {
-                    first_contact: true,
-                    ..CollideOptions::default()
-                };
-                let r = collide(&va, pa, &vb, pb, &first, context)?;
-                let answer = r.colliding.then_some(Answer::Contact);
-                outcome(answer, None, r.stats, r.colliding)
-            }
-            (Effect::Contact | Effect::Contacts, _) => {
-                let r = collide(&va, pa, &vb, pb, &CollideOptions::default(), context)?;
-                let answer = match job.effect {
-                    Effect::Contact => r.colliding.then_some(Answer::Contact),
-                    _ => r.colliding.then_some(Answer::Contacts(r.pairs)),
-                };
-                outcome(answer, None, r.stats, false)
-            }
-            (Effect::Clearance { clearance }, false) => {
-                let r = within_tolerance(&va, pa, &vb, pb, clearance, rule, context)?;
-                let answer = r.witness.map(|w| Answer::Closer {
-                    tri_a: w.tri_a,
-                    tri_b: w.tri_b,
-                    distance: w.distance,
-                });
-                outcome(answer, None, r.stats, r.closer)
-            }
-            (Effect::Clearance { clearance }, true) => {
-                let r = distance(&va, pa, &vb, pb, &exact, context)?;
-                let answer = (r.distance < clearance).then_some(Answer::Closer {
-                    tri_a: r.tri_a,
-                    tri_b: r.tri_b,
-                    distance: r.distance,
-                });
-                outcome(answer, None, r.stats, false)
-            }
-            (
-                Effect::Distance {
-                    rel_err,
-                    max_distance,
-                },
-                _,
-            ) => {
-                let options = if naive {
-                    exact
-                } else {
-                    DistanceOptions {
-                        rel_err,
-                        warm_start: job.warm,
-                        ..DistanceOptions::default()
-                    }
-                };
-                let measured = |r: &crate::query::DistanceResult| Answer::Distance {
-                    distance: r.distance,
-                    tri_a: r.tri_a,
-                    tri_b: r.tri_b,
-                };
-                match max_distance {
-                    Some(limit) if !naive => {
-                        let (r, stats) =
-                            distance_below(&va, pa, &vb, pb, &options, limit, context)?;
-                        let far = r.is_none();
-                        let witness = r.as_ref().map(|r| r.witness);
-                        let answer = r.as_ref().map_or(Answer::Far, measured);
-                        outcome(Some(answer), witness, stats, far)
-                    }
-                    _ => {
-                        let r = distance(&va, pa, &vb, pb, &options, context)?;
-                        let far = max_distance.is_some_and(|limit| r.distance >= limit);
-                        let answer = if far { Answer::Far } else { measured(&r) };
-                        outcome(Some(answer), Some(r.witness), r.stats, false)
-                    }
-                }
-            }
-            (Effect::Span, _) => {
-                let r = span(&va, pa, &vb, pb, rule, context)?;
-                outcome(Some(Answer::Span(r.span)), None, r.stats, false)
-            }
-        })
-    })
-}
-
-/// The poses one frame changes; objects not named keep theirs.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Frame {
-    /// `(object, pose)`, in any order; a later entry for the same object wins.
-    pub poses: Vec<(ObjectId, Pose)>,
-}
-
-impl Frame {
-    /// A frame that moves nothing.
-    pub fn new() -> Frame {
-        Frame::default()
-    }
-
-    /// Moves `object` to `pose` in this frame.
-    pub fn set(&mut self, object: ObjectId, pose: Pose) -> &mut Frame {
-        self.poses.push((object, pose));
-        self
-    }
 }
