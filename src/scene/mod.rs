@@ -43,6 +43,7 @@ mod narrow;
 mod object;
 mod report;
 mod rules;
+mod schedule;
 mod simulate;
 
 pub use builder::SceneBuilder;

@@ -8,6 +8,8 @@ use crate::query::{
     collide, distance, distance_below, span, with_views, within_tolerance, CollideOptions,
     DescentRule, DistanceOptions, QueryContext, QueryError, Side, Stats, Witness,
 };
+use rayon::prelude::*;
+use std::time::Instant;
 
 /// A narrow query to run.
 #[derive(Clone, Copy, Debug)]
@@ -35,9 +37,29 @@ pub(super) struct Outcome {
     pub(super) seconds: f64,
 }
 
+/// Runs `jobs` in parallel (one query context per thread), each outcome timed, in the
+/// order of `jobs`; `objects` are the scene's, at this frame's poses.
+pub(super) fn run_jobs(
+    jobs: &[Job],
+    objects: &[SceneObject],
+    naive: bool,
+) -> Vec<Result<Outcome, QueryError>> {
+    jobs.par_iter()
+        .with_min_len(4)
+        .map_init(QueryContext::new, |context, job| {
+            let started = Instant::now();
+            let mut outcome = run_job(job, objects, naive, context);
+            if let Ok(o) = &mut outcome {
+                o.seconds = started.elapsed().as_secs_f64();
+            }
+            outcome
+        })
+        .collect()
+}
+
 /// Runs one narrow query: the cheapest that answers the effect, or (naive) the full exact
 /// one.
-pub(super) fn run_job(
+fn run_job(
     job: &Job,
     objects: &[SceneObject],
     naive: bool,
