@@ -38,7 +38,7 @@ mod builder;
 mod error;
 mod file;
 mod frame;
-mod frames;
+mod frame_reader;
 mod narrow;
 mod object;
 mod report;
@@ -50,7 +50,7 @@ pub use builder::SceneBuilder;
 pub use error::SceneError;
 pub use file::{load, LoadedScene};
 pub use frame::Frame;
-pub use frames::FrameReader;
+pub use frame_reader::FrameReader;
 pub use object::SceneObject;
 pub use report::{
     Answer, EffectWork, Event, EventKind, FrameReport, NarrowWork, ObjectId, PairReport, Summary,
