@@ -124,7 +124,7 @@ impl Scene {
             let outcome = outcome.map_err(|e| {
                 let (a, b) = (job.pair.0 as usize, job.pair.1 as usize);
                 let name = |i: usize| self.names.get(i).cloned().unwrap_or_default();
-                SceneError::new("scene", format!("{} and {}: {e}", name(a), name(b)))
+                SceneError::new("scene", format!("{} and {}: {e}", name(a), name(b))).caused_by(e)
             })?;
             self.schedule
                 .record(job, outcome, &mut self.summary, &mut events);
