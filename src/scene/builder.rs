@@ -26,13 +26,13 @@ pub(crate) struct Problem {
 }
 
 impl Problem {
-    /// As a located error: `rule 3, field a: ...` in `source`, at `line` when known.
-    pub(crate) fn located(self, source: &str, line: Option<usize>) -> SceneError {
+    /// As a located error: `rule 3, field a: ...` in `origin`, at `line` when known.
+    pub(crate) fn located(self, origin: &str, line: Option<usize>) -> SceneError {
         let item = match self.item {
             Item::Object(k) => format!("object {}, field {}", k + 1, self.field),
             Item::Rule(k) => format!("rule {}, field {}", k + 1, self.field),
         };
-        let e = SceneError::new(source, self.message).in_field(item);
+        let e = SceneError::new(origin, self.message).in_field(item);
         match line {
             Some(line) => e.at_line(line),
             None => e,

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 /// A refused scene file, asset or frame, or a query that failed in a scene.
 ///
-/// Displayed as one line, `SOURCE:LINE: FIELD: MESSAGE` (parts omitted when unknown), for
+/// Displayed as one line, `ORIGIN:LINE: FIELD: MESSAGE` (parts omitted when unknown), for
 /// example `cell.toml:14: rule 2, field a: no object or group named "robto"`.
 ///
 /// When another error is why (an I/O error, a TOML or JSON error, a pose, tree, mesh or
@@ -17,8 +17,10 @@ use std::sync::Arc;
 /// message without toml's own location and snippet, which `:LINE` replaces.)
 #[derive(Clone, Debug)]
 pub struct SceneError {
-    /// The file (or `-` for standard input, or `scene` for one built in code).
-    pub source: String,
+    /// Where the problem is: the file (`-` for standard input), `scene` for a scene built
+    /// in code and its queries, or `frame` for a frame built in code. Not named `source`,
+    /// which for errors means the cause ([`Error::source`]).
+    pub origin: String,
     /// The line, from 1, when the problem has one.
     pub line: Option<usize>,
     /// The item and field, e.g. `rule 2, field effect` or `poses.link2`.
@@ -31,10 +33,10 @@ pub struct SceneError {
 }
 
 impl SceneError {
-    /// An error in `source` about `message`, without a place yet.
-    pub fn new(source: impl Into<String>, message: impl Into<String>) -> SceneError {
+    /// An error in `origin` about `message`, without a place yet.
+    pub fn new(origin: impl Into<String>, message: impl Into<String>) -> SceneError {
         SceneError {
-            source: source.into(),
+            origin: origin.into(),
             line: None,
             field: None,
             message: message.into(),
@@ -64,7 +66,7 @@ impl SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.source)?;
+        write!(f, "{}", self.origin)?;
         if let Some(line) = self.line {
             write!(f, ":{line}")?;
         }
