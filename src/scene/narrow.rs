@@ -150,13 +150,13 @@ fn run_job(
                             distance_below(&va, pa, &vb, pb, &options, limit, context)?;
                         let far = r.is_none();
                         let witness = r.as_ref().map(|r| r.witness);
-                        let answer = r.as_ref().map_or(Answer::Far, measured);
+                        let answer = r.as_ref().map_or(Answer::Beyond, measured);
                         outcome(Some(answer), witness, stats, far)
                     }
                     _ => {
                         let r = distance(&va, pa, &vb, pb, &options, context)?;
                         let far = max_distance.is_some_and(|limit| r.distance >= limit);
-                        let answer = if far { Answer::Far } else { measured(&r) };
+                        let answer = if far { Answer::Beyond } else { measured(&r) };
                         outcome(Some(answer), Some(r.witness), r.stats, false)
                     }
                 }

@@ -19,7 +19,8 @@ pub enum Effect {
     Distance {
         /// Relative error allowed (0: exact).
         rel_err: f64,
-        /// Beyond this distance the answer is "far" and no exact value is computed.
+        /// At this distance or more the answer is [`Answer::Beyond`](super::Answer::Beyond)
+        /// and no exact value is computed.
         max_distance: Option<f64>,
     },
     /// The span: the largest distance between the two.

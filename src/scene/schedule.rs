@@ -50,7 +50,7 @@ pub(super) struct Schedule {
 
 impl Schedule {
     /// The schedule of `objects` at their current poses under the rules of `table`, before
-    /// any frame: limited distances start "beyond", every other pair empty.
+    /// any frame: limited distances start beyond `max_distance`, every other pair empty.
     pub(super) fn new(objects: &[SceneObject], table: RuleTable) -> Schedule {
         let margins: Vec<f64> = (0..objects.len())
             .map(|i| 0.5 * table.reach_of(i))
@@ -94,7 +94,7 @@ impl Schedule {
                     ..
                 }
             )
-            .then_some(Answer::Far);
+            .then_some(Answer::Beyond);
             states.insert(
                 pair,
                 PairState {
@@ -182,7 +182,8 @@ impl Schedule {
             if let Some(state) = self.states.get_mut(&pair) {
                 state.answered = None;
                 let before = state.answer.take();
-                let empty = matches!(state.effect, Effect::Distance { .. }).then_some(Answer::Far);
+                let empty =
+                    matches!(state.effect, Effect::Distance { .. }).then_some(Answer::Beyond);
                 set_answer(&mut self.listed, pair, state, empty, before, events);
             }
         }

@@ -16,12 +16,12 @@ use std::time::Instant;
 /// Per frame the scheduler: moves the world boxes of the objects that moved (from their
 /// root volumes, no traversal); runs a sweep-and-prune broad phase whose boxes are inflated
 /// by the clearance or `max_distance` the object's rules need, so a culled pair's answer is
-/// known empty (no contact, not closer, far); reuses the answer of a pair neither of whose
-/// objects moved; and runs, in parallel, the cheapest query that answers each remaining
-/// pair: first contact for `contact`, all pairs for `contacts`, the tolerance query for
-/// `clearance`, a distance bounded by `max_distance` (within `rel_err`) and warm-started
-/// from the previous frame's pair for `distance`, and the span for `span`. With
-/// [`Scene::set_naive`] it instead runs every pair's full exact query every frame: the
+/// known empty (no contact, not closer, beyond `max_distance`); reuses the answer of a pair
+/// neither of whose objects moved; and runs, in parallel, the cheapest query that answers
+/// each remaining pair: first contact for `contact`, all pairs for `contacts`, the
+/// tolerance query for `clearance`, a distance bounded by `max_distance` (within `rel_err`)
+/// and warm-started from the previous frame's pair for `distance`, and the span for `span`.
+/// With [`Scene::set_naive`] it instead runs every pair's full exact query every frame: the
 /// reference the fast path must agree with.
 #[derive(Debug)]
 pub struct Scene {
