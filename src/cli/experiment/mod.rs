@@ -1,6 +1,8 @@
 //! `obbtree experiment`: the dissertation's chapter 5 experiments, run end to end, with
 //! their CSV files, plots and a table of measured against reported figures.
 
+mod table;
+
 use super::build::load_mesh;
 use super::files::write_file;
 use super::plot::{self, Chart, Series};
@@ -118,7 +120,7 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
         plot::write(&chart, &path)?;
         written.push(path);
     }
-    print_table(&outcome, args.quick)?;
+    table::print_comparisons(&outcome, args.quick)?;
     out!("")?;
     out!(
         "ran in {} ({} queries)",
@@ -183,48 +185,7 @@ fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(
         plot::write(&accuracy_chart(&trades, &scenes, query), &path)?;
         written.push(path);
     }
-    for scene in &scenes {
-        for query in ["distance", "collision"] {
-            let mut rows: Vec<&accuracy::Trade> = trades
-                .iter()
-                .filter(|t| t.scene == scene.name && t.query == query)
-                .collect();
-            rows.sort_by(|p, q| p.seconds.total_cmp(&q.seconds));
-            let poses = if query == "distance" {
-                scene.apart.len()
-            } else {
-                scene.crossing.len()
-            };
-            let error = if query == "distance" {
-                "relative excess of the distance"
-            } else {
-                "share of contacting pairs gained or lost"
-            };
-            out!(
-                "{} {query} ({poses} poses; time summed over them; error: {error}; * on the Pareto front):",
-                scene.name
-            )?;
-            out!(
-                "  {:<40} {:>10} {:>12} {:>12} {:>10}",
-                "choice",
-                "time",
-                "error mean",
-                "error max",
-                "bv tests"
-            )?;
-            for t in rows {
-                out!(
-                    "  {:<40} {:>10} {:>12.2e} {:>12.2e} {:>10.0} {}",
-                    t.choice,
-                    human_seconds(t.seconds),
-                    t.error_mean,
-                    t.error_max,
-                    t.bv_tests,
-                    if t.pareto { "*" } else { "" }
-                )?;
-            }
-        }
-    }
+    table::print_trades(&trades, &scenes)?;
     out!("")?;
     out!("ran in {}", human_seconds(seconds))?;
     for path in written {
@@ -298,31 +259,6 @@ fn create_out(dir: &Path) -> Result<(), Failure> {
 
 fn queries(outcome: &Outcome) -> u64 {
     outcome.points.iter().map(|p| u64::from(p.queries)).sum()
-}
-
-fn print_table(outcome: &Outcome, quick: bool) -> Result<(), Failure> {
-    let width = |column: fn(&experiment::Comparison) -> &str| {
-        let cells = outcome
-            .comparisons
-            .iter()
-            .map(|c| column(c).chars().count());
-        cells.max().unwrap_or(0)
-    };
-    let (what, reported) = (width(|c| &c.what), width(|c| &c.dissertation).max(12));
-    out!("{}: measured against the dissertation", outcome.name)?;
-    if quick {
-        out!("  (--quick: smaller meshes and fewer queries, so sizes and counts differ by construction)")?;
-    }
-    out!("  {:<what$}  {:<reported$}  measured", "", "dissertation")?;
-    for c in &outcome.comparisons {
-        out!(
-            "  {:<what$}  {:<reported$}  {}",
-            c.what,
-            c.dissertation,
-            c.measured
-        )?;
-    }
-    Ok(())
 }
 
 /// The CSV of every point: one row per volume type and parameter value.
