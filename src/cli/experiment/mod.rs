@@ -1,10 +1,10 @@
 //! `obbtree experiment`: the dissertation's chapter 5 experiments, run end to end, with
 //! their CSV files, plots and a table of measured against reported figures.
 
+mod csv;
 mod table;
 
 use super::build::load_mesh;
-use super::files::write_file;
 use super::plot::{self, Chart, Series};
 use super::print::out;
 use super::progress::with_progress;
@@ -111,9 +111,9 @@ pub fn run(args: &ExperimentArgs) -> Result<(), Failure> {
         .ok_or_else(|| Failure(format!("{label}: the experiment crashed")))???;
     let seconds = started.elapsed().as_secs_f64();
     create_out(&args.out)?;
-    let mut written = vec![write_csv(&outcome, &args.out)?];
+    let mut written = vec![csv::write_points(&outcome, &args.out)?];
     if !outcome.fits.is_empty() {
-        written.push(write_fits(&outcome, &args.out)?);
+        written.push(csv::write_fits(&outcome, &args.out)?);
     }
     for (name, chart) in charts(&outcome) {
         let path = args.out.join(format!("{}-{name}.svg", outcome.name));
@@ -158,28 +158,7 @@ fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(
     let trades = accuracy::run(&scenes, repeat)?;
     let seconds = started.elapsed().as_secs_f64();
     create_out(&args.out)?;
-    // Times are summed over the scene's poses (each pose's median); errors are relative
-    // excesses of the distance, or shares of contacting pairs differing.
-    let mut text = String::from(
-        "scene,query,choice,seconds_all_poses,error_mean,error_max,bv_tests_mean,pareto\n",
-    );
-    let quoted = |field: &str| format!("\"{}\"", field.replace('"', "\"\""));
-    for t in &trades {
-        text.push_str(&format!(
-            "{},{},{},{},{},{},{},{}\n",
-            quoted(&t.scene),
-            t.query,
-            quoted(&t.choice),
-            t.seconds,
-            t.error_mean,
-            t.error_max,
-            t.bv_tests,
-            t.pareto
-        ));
-    }
-    let csv = args.out.join("accuracy.csv");
-    write_file(&csv, text.as_bytes())?;
-    let mut written = vec![csv];
+    let mut written = vec![csv::write_trades(&trades, &args.out)?];
     for query in ["distance", "collision"] {
         let path = args.out.join(format!("accuracy-{query}.svg"));
         plot::write(&accuracy_chart(&trades, &scenes, query), &path)?;
@@ -259,61 +238,6 @@ fn create_out(dir: &Path) -> Result<(), Failure> {
 
 fn queries(outcome: &Outcome) -> u64 {
     outcome.points.iter().map(|p| u64::from(p.queries)).sum()
-}
-
-/// The CSV of every point: one row per volume type and parameter value.
-fn write_csv(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
-    // Means of the queries at each point; the time is the median of one query.
-    let mut text = format!(
-        "volume,{},queries,contacts,bv_disjoint,bv_overlap,tri_separated,tri_contact,bv_tests,tri_tests,bv_test_lower_bound,seconds\n",
-        outcome.x_column
-    );
-    for p in &outcome.points {
-        // No contacts, no bound: an empty field, as `collide --csv` writes it.
-        let bound = if p.lower_bound > 0.0 {
-            p.lower_bound.to_string()
-        } else {
-            String::new()
-        };
-        text.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            p.label(),
-            p.x,
-            p.queries,
-            p.contacts,
-            p.disjoint,
-            p.overlap,
-            p.separated,
-            p.contacts,
-            p.bv_tests(),
-            p.tri_tests(),
-            bound,
-            p.seconds
-        ));
-    }
-    let path = dir.join(format!("{}.csv", outcome.name));
-    write_file(&path, text.as_bytes())?;
-    Ok(path)
-}
-
-/// The fitted lines, one row each: `log10(measure) = slope · log10(x) + intercept` over
-/// `from` to `to`.
-fn write_fits(outcome: &Outcome, dir: &Path) -> Result<PathBuf, Failure> {
-    let mut text = String::from("bv,measure,slope,intercept,from,to\n");
-    for f in &outcome.fits {
-        text.push_str(&format!(
-            "{},{},{},{},{},{}\n",
-            f.bv.name(),
-            f.measure,
-            f.line.slope,
-            f.line.intercept,
-            f.from,
-            f.to
-        ));
-    }
-    let path = dir.join(format!("{}-fits.csv", outcome.name));
-    write_file(&path, text.as_bytes())?;
-    Ok(path)
 }
 
 /// The palette index of a volume type's series (its place in `BvKind::ALL`).
