@@ -120,18 +120,13 @@ pub const SLIDING: [ChartSpec; 4] = [
 
 /// The parallel close proximity charts (§5.3.2).
 pub const PROXIMITY: [ChartSpec; 2] = [
-    ChartSpec {
-        file: "bv-tests",
-        title: "Parallel close proximity (Fig. 5.11)",
-        x_label: None,
-        y_label: "volume tests (mean)",
-        log_x: true,
-        log_y: true,
-        plotted: Plotted::PerKind {
-            measure: Measure::BvTests,
-            fits: Some("bv_tests"),
-        },
-    },
+    slope_chart(
+        "bv-tests",
+        "Parallel close proximity (Fig. 5.11)",
+        "volume tests (mean)",
+        Measure::BvTests,
+        "bv_tests",
+    ),
     ChartSpec {
         file: "thickness",
         title: "Mean thickness per level, inner sphere (Fig. 5.17)",
@@ -145,31 +140,45 @@ pub const PROXIMITY: [ChartSpec; 2] = [
 
 /// The transverse contact charts (§5.3.3.1).
 pub const TRANSVERSE: [ChartSpec; 2] = [
-    ChartSpec {
-        file: "contacts",
-        title: "Contacts against tessellation (Fig. 5.21)",
-        x_label: None,
-        y_label: "contacts (mean)",
-        log_x: true,
-        log_y: true,
-        plotted: Plotted::PerKind {
-            measure: Measure::Contacts,
-            fits: Some("contacts"),
-        },
-    },
-    ChartSpec {
-        file: "bv-tests",
-        title: "Volume tests against tessellation (Fig. 5.22)",
-        x_label: None,
-        y_label: "volume tests (mean)",
-        log_x: true,
-        log_y: true,
-        plotted: Plotted::PerKind {
-            measure: Measure::BvTests,
-            fits: Some("bv_tests"),
-        },
-    },
+    slope_chart(
+        "contacts",
+        "Contacts against tessellation (Fig. 5.21)",
+        "contacts (mean)",
+        Measure::Contacts,
+        "contacts",
+    ),
+    slope_chart(
+        "bv-tests",
+        "Volume tests against tessellation (Fig. 5.22)",
+        "volume tests (mean)",
+        Measure::BvTests,
+        "bv_tests",
+    ),
 ];
+
+/// A chart whose slope the dissertation reads off: `measure` per volume type against the
+/// experiment's parameter with the lines fitted to it (named `fits` by the library), on
+/// log-log axes, where those lines are straight.
+const fn slope_chart(
+    file: &'static str,
+    title: &'static str,
+    y_label: &'static str,
+    measure: Measure,
+    fits: &'static str,
+) -> ChartSpec {
+    ChartSpec {
+        file,
+        title,
+        x_label: None,
+        y_label,
+        log_x: true,
+        log_y: true,
+        plotted: Plotted::PerKind {
+            measure,
+            fits: Some(fits),
+        },
+    }
+}
 
 impl ChartSpec {
     /// The chart of `outcome` this spec describes.
