@@ -214,3 +214,52 @@ pub fn human_seconds(seconds: f64) -> String {
         format!("{seconds:.2} s")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use obbtree::experiment::ExperimentError;
+    use obbtree::format::{ObbtFile, VerifyError};
+    use obbtree::mesh::TriMesh;
+    use std::path::Path;
+
+    #[test]
+    fn the_chain_joins_context_error_and_causes() {
+        let levels = ExperimentError::Levels(VerifyError {
+            region: "padding".into(),
+            problem: "byte 7 is not 0".into(),
+        });
+        let failure = Failure::from(levels).context("proximity");
+        assert_eq!(
+            failure.to_string(),
+            "proximity: measuring a tree's levels: padding: byte 7 is not 0"
+        );
+        let failure: Result<(), _> = Err(Failure::msg("inner")).with_context(|| "outer");
+        assert_eq!(
+            failure.map_err(|f| f.to_string()),
+            Err("outer: inner".into())
+        );
+    }
+
+    /// Errors whose message already ends with their cause's text must not return the cause
+    /// from `source()` too, or the chain would show it twice.
+    #[test]
+    fn causes_in_the_message_are_printed_once() {
+        let missing = Path::new("no-such-dir/missing.obbt");
+        let os_error = std::fs::read(missing).unwrap_err().to_string();
+        let Err(open) = ObbtFile::open(missing) else {
+            panic!("opened {missing:?}")
+        };
+        let Err(load) = TriMesh::load(missing) else {
+            panic!("loaded {missing:?}")
+        };
+        let cases = [
+            (open.to_string(), Failure::from(open)),
+            (load.to_string(), Failure::from(load)),
+        ];
+        for (message, failure) in cases {
+            assert!(message.ends_with(&os_error), "{message}");
+            assert_eq!(failure.to_string(), message);
+        }
+    }
+}
