@@ -70,7 +70,7 @@ pub enum ExperimentError {
     #[error(transparent)]
     Build(#[from] BuildError),
     /// A scene's tree could not be built.
-    #[error("scene {scene}: {source}")]
+    #[error("scene {scene}")]
     Scene {
         /// The scene's name (a mesh's file name).
         scene: String,
@@ -82,8 +82,8 @@ pub enum ExperimentError {
     #[error(transparent)]
     Query(#[from] QueryError),
     /// A tree's levels could not be measured (a bug: the experiments' trees are sound).
-    #[error("measuring a tree's levels: {0}")]
-    Levels(crate::format::VerifyError),
+    #[error("measuring a tree's levels")]
+    Levels(#[source] crate::format::VerifyError),
 }
 
 /// How the trees are built and their volumes tested, beyond the volume type: today's
