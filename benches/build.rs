@@ -9,6 +9,8 @@
 //!
 //! Run: `cargo bench --bench build`. Meshes outside the repository are optional: a missing
 //! one is reported and its benchmarks skipped.
+// A benchmark of known-good inputs: a setup that fails is a broken benchmark, not bad input.
+#![allow(clippy::expect_used)]
 
 #[path = "../tests/common/mod.rs"]
 mod common;

@@ -1,6 +1,9 @@
 //! Builds a mesh repeatedly (for profiling the builder):
 //! `cargo run --release --example profile_build -- MESH [FIT] [N] [HULL_MIN_FACES] [HULL_MAX_POINTS|all]`
 //! (threads: `RAYON_NUM_THREADS`).
+// A tool developers run by hand: stopping loudly on a broken input is what it should do.
+#![allow(clippy::expect_used)]
+
 use obbtree::build::{build, BuildOptions};
 use obbtree::fit::FitMethod;
 use obbtree::mesh::TriMesh;

@@ -6,6 +6,8 @@
 //! (0.2 … 2.2), or with DIR (a case kept by `OBBTREE_PEERS_KEEP=1 cargo bench --bench
 //! peers`: `a.obj`, `b.obj`, `poses.txt`) the index of a pose line. Prints the work of one
 //! query and the median time per query.
+// A tool developers run by hand: stopping loudly on a broken input is what it should do.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 #[path = "../tests/common/mod.rs"]
 mod common;

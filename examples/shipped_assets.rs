@@ -8,6 +8,8 @@
 //!
 //! At run time the app maps the files (O(1), nothing parsed), verifies them once, and then
 //! answers collision, distance and span queries from several threads sharing the maps.
+// A tool developers run by hand: stopping loudly on a broken input is what it should do.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::format::ObbtFile;

@@ -7,6 +7,8 @@
 //! poses: all-pairs collision and first contact with the copy moved 0.2 to 0.65 of the
 //! model's diagonal, exact distance with it 1.05 to 3 diagonals away. Prints the
 //! one-thread build time and the summed work (deterministic, unlike the time).
+// A tool developers run by hand: stopping loudly on a broken input is what it should do.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 #[path = "../tests/common/mod.rs"]
 mod common;

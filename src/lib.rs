@@ -70,24 +70,9 @@
 //! The library never panics on data it did not make: damaged files, meshes and poses
 //! give errors (see docs/DESIGN.md, Robustness).
 #![forbid(unsafe_op_in_unsafe_fn)]
-// The library never panics on data it did not make (files, meshes, poses): outside tests,
-// no unwrap / expect / panic, and every index or slice is checked (`get`) or, where it is in
-// bounds by construction, allowed narrowly with the reason. Integer arithmetic and narrowing
-// casts are also linted in the modules that parse untrusted bytes (`format`, `mesh`, `tree`).
-#![cfg_attr(
-    not(test),
-    deny(
-        clippy::unwrap_used,
-        clippy::expect_used,
-        clippy::panic,
-        clippy::unreachable,
-        clippy::todo,
-        clippy::unimplemented,
-        clippy::indexing_slicing,
-        clippy::string_slice,
-        clippy::unwrap_in_result
-    )
-)]
+// The no-panic lints (no unwrap / expect / panic / unchecked indexing outside tests) are
+// in Cargo.toml's `[lints.clippy]`; integer arithmetic and narrowing casts are also linted
+// in the modules that parse untrusted bytes (`format`, `mesh`, `tree`, `stats`).
 
 /// The nalgebra this crate's API uses (poses, points), re-exported so an application can
 /// name exactly these types without adding a second, possibly different nalgebra.

@@ -1,5 +1,7 @@
 //! Build -> write -> open: identical arrays and bytes, determinism, and volumes that contain
 //! what is below them, for every volume type, both precisions and two leaf sizes.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 mod common;
 

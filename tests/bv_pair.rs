@@ -1,5 +1,7 @@
 //! Pair tests of volumes under a relative pose: overlap is conservative, the distance lower
 //! bound is a lower bound, the box maximum distance is exact.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 mod common;
 

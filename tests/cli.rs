@@ -1,4 +1,11 @@
 //! The command-line contract: exit statuses, one-line errors, `info --json` fields.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::string_slice
+)]
 
 mod common;
 

@@ -1,5 +1,7 @@
 //! Many threads query one mapped file: 8 threads x 1,000 mixed queries, each answer equal to
 //! the single-threaded one.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::unwrap_used)]
 
 mod common;
 

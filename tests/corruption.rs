@@ -1,5 +1,7 @@
 //! Any change to a file's bytes is caught: single-byte flips by `open` or `verify`,
 //! truncations by `open`. Nothing panics.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::indexing_slicing)]
 
 mod common;
 

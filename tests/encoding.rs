@@ -1,4 +1,6 @@
 //! The packed 32-bit references of §7.2.2: round trips at the limits, overflow refused.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::panic)]
 
 mod common;
 

@@ -1,6 +1,13 @@
 //! The experiment tools from the command line (issue: chapter 5 as commands): generated
 //! shapes and poses, batch controls (`--csv`, `--repeat`, `--threads`) and `info --levels`,
 //! checked against the identities of the dissertation's chapter 2.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
 
 mod common;
 

@@ -1,5 +1,7 @@
 //! Tests of the fitting module (dissertation chapter 3): principal-axes frames for the
 //! three covariance methods, their degenerate cases, and the convex hull.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::panic, clippy::indexing_slicing)]
 
 use nalgebra::{Matrix3, Rotation3, SymmetricEigen, Vector3};
 use obbtree::fit::hull::{convex_hull, ConvexHull, HULL_TOLERANCE};

@@ -2,6 +2,8 @@
 //! checked-in seeds) and of `fuzz/regressions/<target>/` (inputs that once crashed a target,
 //! kept after the fix) goes through the same harness function the cargo-fuzz target runs.
 //! See `fuzz/README.md`.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::panic)]
 
 #[path = "../fuzz/harness.rs"]
 mod harness;

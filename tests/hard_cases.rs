@@ -12,6 +12,8 @@
 //!   model scales 1e-3, 1 and 1e3 and offsets of 1e6: contact flips exactly when the gap
 //!   closes and the distance error stays within the bound documented in the README;
 //! - a million eccentric slivers, and the cube (the covariance fit's worst case, §3.5.2).
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::unwrap_used)]
 
 mod common;
 

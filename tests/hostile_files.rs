@@ -13,6 +13,8 @@
 //!
 //! Where a damaged file still verifies, its collision answer must equal a brute force over
 //! the triangles it stores. Each suite prints its tallies (`--nocapture` shows them).
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::panic)]
 
 mod common;
 

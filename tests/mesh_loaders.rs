@@ -1,5 +1,7 @@
 //! The OBJ and STL loaders and `TriMesh` validation, on the fixtures in
 //! `tests/fixtures/mesh/`, the bundled `assets/cow.obj`, and bytes made here.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -1,5 +1,7 @@
 //! Poses as people have them: four layouts, nalgebra types, and rotations printed with few
 //! decimals repaired to the nearest rotation (or refused, without the repair).
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::indexing_slicing)]
 
 use obbtree::nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use obbtree::query::{Pose, PoseError, PoseFormat, MAX_REPAIR};

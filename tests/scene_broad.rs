@@ -2,6 +2,8 @@
 //! frame after frame, as brute force over all pairs says: random boxes on a grid of
 //! eighths (so touching and equal coordinates are frequent), moving a little or jumping,
 //! with a filter on the pairs wanted.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::indexing_slicing)]
 
 use obbtree::scene::broad::{Bounds, SweepAndPrune};
 use proptest::prelude::*;

@@ -1,6 +1,8 @@
 //! `obbtree scene`: the shipped robot cell, its precomputed assets, and scenes and frames
 //! that are wrong in every way the issue lists, each refused with one line naming the
 //! file, the line and the field.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 mod common;
 

@@ -13,7 +13,7 @@ use std::sync::Arc;
 /// (static), and `d` coming down along y towards `c`, one unit per frame, from y = 10 to
 /// y = 1 (touching `c`).
 ///
-/// Rules: everything `contact`; `a`–`c` a distance limited to 1 (always far); `a`–`d` a
+/// Rules: everything `contact`; `a`–`c` a distance limited to 1 (always beyond); `a`–`d` a
 /// distance without limit (every frame); `c`–`d` a clearance of 0.5; `b`–`c` none.
 #[test]
 fn counters_of_a_scene_built_for_them() {
@@ -54,7 +54,7 @@ fn counters_of_a_scene_built_for_them() {
             0 => {
                 assert_eq!(listed, [(a, b), (a, c), (a, d)]);
                 assert_eq!(events, [(a, b, EventKind::ContactStarted)]);
-                assert_eq!(report.pairs[1].answer, Answer::Far);
+                assert_eq!(report.pairs[1].answer, Answer::Beyond);
             }
             9 => {
                 assert_eq!(listed, [(a, b), (a, c), (a, d), (c, d)]);

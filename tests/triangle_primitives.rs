@@ -6,6 +6,8 @@
 //! references: an exact integer oracle for contact on grid coordinates, a brute-force
 //! distance by convex one-dimensional searches, plus sampling and separating-plane
 //! certificates that do not depend on any formula.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::indexing_slicing)]
 
 use nalgebra::Vector3;
 use obbtree::query::triangle::{

@@ -3,6 +3,8 @@
 //! from their origin can then be queried together, and the `placement` section of format 1.1
 //! (written only when it says something, checked by `open` and `verify`, skipped by readers
 //! that do not know it).
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 mod common;
 

@@ -9,6 +9,8 @@
 //! order. Every count is deterministic, so a failure means the work changed. A deliberate
 //! change updates the table (the failure prints the new one) and says before and after in
 //! its commit message.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used)]
 
 mod common;
 

@@ -182,8 +182,10 @@ pub enum BuildError {
     #[error("--sphere-fit minimal applies to sphere trees, not to {} trees (--bv sphere)", .0.name())]
     SphereFit(BvKind),
     /// The mesh is too large for the 32-bit references of the file format.
+    // The reason is in the message, not in `source()`: callers that keep only the message
+    // (a scene's error lines) show it, and a chain printer would otherwise show it twice.
     #[error("the mesh is too large for the .obbt format: {0}")]
-    TooLarge(#[from] EncodeError),
+    TooLarge(EncodeError),
     /// More triangles or vertices than a 32-bit count holds.
     #[error("the mesh has {count} {what}; the .obbt format holds at most {max}")]
     TooManyElements {

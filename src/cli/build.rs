@@ -2,7 +2,7 @@
 
 use super::files::check_output;
 use super::progress::with_progress;
-use super::{human_bytes, Failure};
+use super::{human_bytes, Failure, WithContext};
 use clap::{Args, ValueEnum};
 use obbtree::build::{build, BuildOptions, SphereFit};
 use obbtree::bv::BvKind;
@@ -234,14 +234,14 @@ pub fn build_with_progress(
         &total,
         work,
     ) {
-        Some(result) => result.map_err(|e| Failure(format!("{label}: {e}"))),
-        None => Err(Failure(format!("{label}: the builder crashed"))),
+        Some(result) => result.with_context(|| label),
+        None => Err(Failure::msg(format!("{label}: the builder crashed"))),
     }
 }
 
 /// Loads a mesh file, naming it in any error.
 pub fn load_mesh(path: &Path) -> Result<TriMesh, Failure> {
-    TriMesh::load(path).map_err(|e| Failure(e.to_string()))
+    Ok(TriMesh::load(path)?)
 }
 
 pub fn run(args: &BuildArgs) -> Result<(), Failure> {
@@ -257,7 +257,7 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     if options.fit != FitMethod::Hull {
         let given = args.tree.given();
         if let Some(flag) = given.iter().find(|flag| flag.starts_with("--hull-")) {
-            return Err(Failure(format!(
+            return Err(Failure::msg(format!(
                 "{flag} applies to --fit hull only (this build fits {})",
                 options.fit.name()
             )));
@@ -270,7 +270,7 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     // Temporaries of an earlier build of this output that was killed outright.
     let _ = remove_stale_temporaries(&args.output);
     file.write_atomic(&args.output)
-        .map_err(|e| Failure(format!("{}: cannot write: {e}", args.output.display())))?;
+        .with_context(|| format!("{}: cannot write", args.output.display()))?;
     if !args.quiet {
         let info = file.info();
         eprintln!(

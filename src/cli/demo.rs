@@ -4,7 +4,7 @@ use super::build::build_with_progress;
 use super::files::check_output;
 use super::print::out;
 use super::scene::SceneArgs;
-use super::{human_bytes, human_seconds, Failure};
+use super::{human_bytes, human_seconds, Failure, WithContext};
 use clap::Args;
 use nalgebra::{Rotation3, Vector3};
 use obbtree::build::BuildOptions;
@@ -77,7 +77,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
             true,
         ),
     };
-    std::fs::create_dir_all(&dir).map_err(|e| Failure(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).with_context(|| dir.display())?;
     let result = run_in(&dir);
     if temporary {
         let _ = std::fs::remove_dir_all(&dir);
@@ -104,16 +104,12 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
         let build_ms = started.elapsed().as_secs_f64() * 1e3;
         let path = dir.join(format!("cow-{}.obbt", bv.name()));
         check_output(&path, &[], false)?;
-        built
-            .write_atomic(&path)
-            .map_err(|e| Failure(format!("{}: {e}", path.display())))?;
+        built.write_atomic(&path).with_context(|| path.display())?;
         let started = Instant::now();
         let opened = ObbtFile::open(&path)?;
         let open_us = started.elapsed().as_secs_f64() * 1e6;
         let started = Instant::now();
-        opened
-            .verify()
-            .map_err(|e| Failure(format!("{}: {e}", path.display())))?;
+        opened.verify().with_context(|| path.display())?;
         let verify_ms = started.elapsed().as_secs_f64() * 1e3;
         let same = opened.bytes() == built.bytes();
         let info = opened.info();
@@ -129,7 +125,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
             if same { "yes" } else { "NO" }
         )?;
         if !same {
-            return Err(Failure(format!(
+            return Err(Failure::msg(format!(
                 "{}: the file read back differs from the tree built",
                 path.display()
             )));
@@ -143,7 +139,7 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
 
 /// The shipped robot cell, fast and then as the naive reference.
 fn run_cell(dir: &std::path::Path) -> Result<(), Failure> {
-    std::fs::create_dir_all(dir).map_err(|e| Failure(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir).with_context(|| dir.display())?;
     for (name, bytes) in CELL {
         let path = dir.join(name);
         // A file already holding these bytes (an earlier demo) is left as it is; anything
@@ -152,7 +148,7 @@ fn run_cell(dir: &std::path::Path) -> Result<(), Failure> {
             continue;
         }
         check_output(&path, &[], false)?;
-        write_atomic(&path, bytes).map_err(|e| Failure(format!("{}: {e}", path.display())))?;
+        write_atomic(&path, bytes).with_context(|| path.display())?;
     }
     out!(
         "scene: the shipped robot cell (an arm sweeping past a fence to a part on a table; obbtree scene {}):",
@@ -177,8 +173,7 @@ fn run_cell(dir: &std::path::Path) -> Result<(), Failure> {
         .frames
         .clone()
         .unwrap_or_else(|| dir.join("cell.jsonl"));
-    let file = std::fs::File::open(&frames_path)
-        .map_err(|e| Failure(format!("{}: {e}", frames_path.display())))?;
+    let file = std::fs::File::open(&frames_path).with_context(|| frames_path.display())?;
     let source = frames_path.display().to_string();
     let format = (quick.pose_format, quick.orthonormalize);
     let frames = FrameReader::new(
@@ -194,7 +189,7 @@ fn run_cell(dir: &std::path::Path) -> Result<(), Failure> {
         let got = quick.scene.step(&frame)?.clone();
         let want = reference.scene.step(&frame)?;
         if let Some(d) = got.disagreement(want, |a, b| quick.scene.effect(a, b)) {
-            return Err(Failure(format!(
+            return Err(Failure::msg(format!(
                 "the scheduler and the reference disagree: {d}"
             )));
         }

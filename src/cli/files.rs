@@ -6,7 +6,7 @@
 //! SIGTERM, SIGHUP) the temporary files of unfinished writes are removed before exiting
 //! with status 130.
 
-use super::Failure;
+use super::{Failure, WithContext};
 use obbtree::format::layout::SIGNATURE;
 use std::io::Read;
 use std::path::Path;
@@ -42,7 +42,7 @@ fn check(
     let shown = output.display();
     for input in inputs {
         if same_file::is_same_file(input, output).unwrap_or(false) {
-            return Err(Failure(format!(
+            return Err(Failure::msg(format!(
                 "{shown}: is the input {}; refusing to overwrite it (choose another -o)",
                 input.display()
             )));
@@ -50,13 +50,13 @@ fn check(
     }
     match std::fs::metadata(output) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(Failure(format!("{shown}: cannot check the output: {e}"))),
-        Ok(m) if m.is_dir() => Err(Failure(format!("{shown}: is a directory"))),
+        Err(e) => Err(Failure::from(e).context(format!("{shown}: cannot check the output"))),
+        Ok(m) if m.is_dir() => Err(Failure::msg(format!("{shown}: is a directory"))),
         Ok(_) if may_replace(output) => Ok(()),
-        Ok(_) if inputs.is_empty() => Err(Failure(format!(
+        Ok(_) if inputs.is_empty() => Err(Failure::msg(format!(
             "{shown}: exists; refusing to replace it (use --force)"
         ))),
-        Ok(_) => Err(Failure(format!(
+        Ok(_) => Err(Failure::msg(format!(
             "{shown}: exists and is not an .obbt file; refusing to replace it (use --force)"
         ))),
     }
@@ -67,7 +67,7 @@ fn check(
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Failure> {
     let _ = obbtree::format::remove_stale_temporaries(path);
     obbtree::format::write_atomic(path, bytes)
-        .map_err(|e| Failure(format!("{}: cannot write: {e}", path.display())))
+        .with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// Makes Ctrl-C, SIGTERM and SIGHUP remove unfinished temporary files and exit with 130.

@@ -172,7 +172,7 @@ pub fn mesh(args: &MeshArgs) -> Result<(), Failure> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
     {
-        return Err(Failure(format!(
+        return Err(Failure::msg(format!(
             "{}: meshes are written as OBJ; name the output *.obj",
             output.display()
         )));

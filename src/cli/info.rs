@@ -36,7 +36,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
     let levels = if args.levels {
         let levels = file
             .level_stats()
-            .map_err(|e| Failure(format!("{name}: {e} (run obbtree verify)")))?;
+            .map_err(|e| Failure::msg(format!("{name}: {e} (run obbtree verify)")))?;
         Some(levels)
     } else {
         None

@@ -16,6 +16,8 @@ mod scene;
 mod verify;
 
 use clap::{Parser, Subcommand};
+use std::error::Error;
+use std::fmt::{self, Display};
 use std::process::ExitCode;
 
 /// Collision queries on triangle meshes with oriented bounding box trees.
@@ -50,13 +52,76 @@ enum Command {
     Poses(generate::PosesArgs),
 }
 
-/// A failure to report: one line, exit status 1.
+/// A failure to report: the typed error that stopped the command, with its `source()`
+/// chain, printed on one line as `obbtree: error: outer: cause: cause` (exit status 1).
+///
+/// Every error converts into it with `?`, keeping its type (so nothing a library error
+/// carries is flattened into a string before it is printed). It is deliberately not an
+/// `Error` itself: that is what lets the blanket `From` below coexist with `From<T> for T`.
 #[derive(Debug)]
-pub struct Failure(pub String);
+pub struct Failure {
+    error: Box<dyn Error + Send + Sync + 'static>,
+}
 
-impl<E: std::fmt::Display> From<E> for Failure {
-    fn from(e: E) -> Self {
-        Failure(e.to_string())
+impl Failure {
+    /// A failure that is only a message, with no typed cause.
+    pub fn msg(message: impl Into<String>) -> Failure {
+        Failure {
+            error: message.into().into(),
+        }
+    }
+
+    /// This failure with `context` in front: it prints as `context: failure`, and the
+    /// typed error stays the cause.
+    pub fn context(self, context: impl Display) -> Failure {
+        Failure {
+            error: Box::new(Context {
+                context: context.to_string(),
+                source: self.error,
+            }),
+        }
+    }
+}
+
+impl<E: Error + Send + Sync + 'static> From<E> for Failure {
+    fn from(error: E) -> Self {
+        Failure {
+            error: Box::new(error),
+        }
+    }
+}
+
+/// The whole chain, joined with `: `. Each error in it shows only its own part and leaves
+/// its cause to `source()`, so no text appears twice.
+impl Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.error)?;
+        let mut cause = self.error.source();
+        while let Some(error) = cause {
+            write!(f, ": {error}")?;
+            cause = error.source();
+        }
+        Ok(())
+    }
+}
+
+/// What [`Failure::context`] puts in front of an error.
+#[derive(Debug, thiserror::Error)]
+#[error("{context}")]
+struct Context {
+    context: String,
+    source: Box<dyn Error + Send + Sync + 'static>,
+}
+
+/// [`Failure::context`] for a `Result`, the context computed only when it failed.
+pub trait WithContext<T> {
+    /// The error, made a [`Failure`], with `context()` in front.
+    fn with_context<C: Display>(self, context: impl FnOnce() -> C) -> Result<T, Failure>;
+}
+
+impl<T, E: Into<Failure>> WithContext<T> for Result<T, E> {
+    fn with_context<C: Display>(self, context: impl FnOnce() -> C) -> Result<T, Failure> {
+        self.map_err(|error| error.into().context(context()))
     }
 }
 
@@ -79,8 +144,8 @@ pub fn main() -> ExitCode {
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure(message)) => {
-            eprintln!("obbtree: error: {message}");
+        Err(failure) => {
+            eprintln!("obbtree: error: {failure}");
             ExitCode::from(1)
         }
     }
@@ -97,7 +162,7 @@ pub fn with_threads<T: Send>(
         Some(n) => Ok(rayon::ThreadPoolBuilder::new()
             .num_threads(n as usize)
             .build()
-            .map_err(|e| Failure(format!("--threads {n}: {e}")))?
+            .with_context(|| format!("--threads {n}"))?
             .install(work)),
     }
 }
@@ -139,5 +204,54 @@ pub fn human_seconds(seconds: f64) -> String {
         format!("{:.2} ms", seconds * 1e3)
     } else {
         format!("{seconds:.2} s")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use obbtree::experiment::ExperimentError;
+    use obbtree::format::{ObbtFile, VerifyError};
+    use obbtree::mesh::TriMesh;
+    use std::path::Path;
+
+    #[test]
+    fn the_chain_joins_context_error_and_causes() {
+        let levels = ExperimentError::Levels(VerifyError {
+            region: "padding".into(),
+            problem: "byte 7 is not 0".into(),
+        });
+        let failure = Failure::from(levels).context("proximity");
+        assert_eq!(
+            failure.to_string(),
+            "proximity: measuring a tree's levels: padding: byte 7 is not 0"
+        );
+        let failure: Result<(), _> = Err(Failure::msg("inner")).with_context(|| "outer");
+        assert_eq!(
+            failure.map_err(|f| f.to_string()),
+            Err("outer: inner".into())
+        );
+    }
+
+    /// Errors whose message already ends with their cause's text must not return the cause
+    /// from `source()` too, or the chain would show it twice.
+    #[test]
+    fn causes_in_the_message_are_printed_once() {
+        let missing = Path::new("no-such-dir/missing.obbt");
+        let os_error = std::fs::read(missing).unwrap_err().to_string();
+        let Err(open) = ObbtFile::open(missing) else {
+            panic!("opened {missing:?}")
+        };
+        let Err(load) = TriMesh::load(missing) else {
+            panic!("loaded {missing:?}")
+        };
+        let cases = [
+            (open.to_string(), Failure::from(open)),
+            (load.to_string(), Failure::from(load)),
+        ];
+        for (message, failure) in cases {
+            assert!(message.ends_with(&os_error), "{message}");
+            assert_eq!(failure.to_string(), message);
+        }
     }
 }

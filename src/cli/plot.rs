@@ -82,7 +82,7 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
         |(x0, x1, y0, y1), (x, y)| (x0.min(x), x1.max(x), y0.min(y), y1.max(y)),
     );
     if !(x0.is_finite() && y0.is_finite()) {
-        return Err(Failure(format!("{}: nothing to plot", chart.title)));
+        return Err(Failure::msg(format!("{}: nothing to plot", chart.title)));
     }
     let pad = |lo: f64, hi: f64, right: f64| {
         let span = if hi > lo { hi - lo } else { 1.0 };
@@ -98,7 +98,7 @@ pub fn svg(chart: &Chart<'_>) -> Result<String, Failure> {
     {
         let root = SVGBackend::with_string(&mut text, (760, 480)).into_drawing_area();
         let fail =
-            |e: &dyn std::fmt::Display| Failure(format!("{}: cannot draw: {e}", chart.title));
+            |e: &dyn std::fmt::Display| Failure::msg(format!("{}: cannot draw: {e}", chart.title));
         root.fill(&WHITE).map_err(|e| fail(&e))?;
         let mut c = ChartBuilder::on(&root)
             .caption(chart.title, ("sans-serif", 20))

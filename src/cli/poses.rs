@@ -1,7 +1,7 @@
 //! Poses from the command line and from pose files, in any [`PoseFormat`], optionally
 //! repaired to the nearest rotation.
 
-use super::Failure;
+use super::{Failure, WithContext};
 use clap::{Args, ValueEnum};
 use obbtree::query::{ParsedPose, Pose, PoseFormat, ORTHONORMAL_TOLERANCE};
 use std::path::PathBuf;
@@ -69,7 +69,7 @@ pub fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>, Failure> {
         .enumerate()
         .map(|(i, t)| {
             t.parse::<f64>()
-                .map_err(|_| Failure(format!("{what}: value {i} ({t:?}) is not a number")))
+                .map_err(|_| Failure::msg(format!("{what}: value {i} ({t:?}) is not a number")))
         })
         .collect()
 }
@@ -123,7 +123,7 @@ impl PoseArgs {
             };
             let parsed = self
                 .parse(&parse_numbers(text, flag)?)
-                .map_err(|e| Failure(format!("{flag}: {e}")))?;
+                .with_context(|| flag)?;
             Ok(repairs.note(&parsed, || flag.to_string()))
         };
         let a = one(self.pose_a.as_deref(), "--pose-a")?;
@@ -138,8 +138,7 @@ impl PoseArgs {
         let Some(path) = &self.poses else {
             return Ok(None);
         };
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Failure(format!("{}: {e}", path.display())))?;
+        let text = std::fs::read_to_string(path).with_context(|| path.display())?;
         let per_pose = self.pose_format.format().numbers();
         let mut repairs = Repairs::default();
         let mut out = Vec::new();
@@ -158,7 +157,7 @@ impl PoseArgs {
                 .split_at_checked(per_pose)
                 .filter(|_| values.len() == 2 * per_pose)
             else {
-                return Err(Failure(format!(
+                return Err(Failure::msg(format!(
                     "{what}: expected {} numbers (pose A then pose B, {} each in format {}), got {}",
                     2 * per_pose,
                     per_pose,
@@ -169,7 +168,7 @@ impl PoseArgs {
             let mut pose = |values: &[f64], which: &str| -> Result<Pose, Failure> {
                 let parsed = self
                     .parse(values)
-                    .map_err(|e| Failure(format!("{what}: pose {which}: {e}")))?;
+                    .with_context(|| format!("{what}: pose {which}"))?;
                 Ok(repairs.note(&parsed, || format!("{what}, pose {which}")))
             };
             let a = pose(a, "A")?;

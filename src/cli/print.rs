@@ -30,7 +30,7 @@ pub fn line(args: std::fmt::Arguments<'_>) -> Result<(), Failure> {
             CLOSED.store(true, Ordering::Relaxed);
             Ok(())
         }
-        Err(e) => Err(Failure(format!("cannot write to standard output: {e}"))),
+        Err(e) => Err(Failure::from(e).context("cannot write to standard output")),
     }
 }
 

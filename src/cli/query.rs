@@ -184,7 +184,7 @@ fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
         .filter(|p| is_tree_input(p))
         .collect();
     if let ([_, _], Some(flag)) = (trees.as_slice(), tree.given().first()) {
-        return Err(Failure(format!(
+        return Err(Failure::msg(format!(
             "{flag} applies to mesh inputs only, and A and B are both .obbt files"
         )));
     }
@@ -192,7 +192,7 @@ fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
     if let Some(path) = trees.first() {
         let info = ObbtFile::open(path)?.info();
         let conflict = |flag: &str, given: String, stored: &str| {
-            Failure(format!(
+            Failure::msg(format!(
                 "{flag} {given}: {} stores {stored}, and a mesh paired with it is built to match",
                 path.display()
             ))
@@ -459,7 +459,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         // Without a maximum distance every query finds a closest pair.
         let w = r
             .closest
-            .ok_or_else(|| Failure("no triangle pair reached".into()))?;
+            .ok_or_else(|| Failure::msg("no triangle pair reached"))?;
         let value = witness_json("distance", &w, &r.work, seconds);
         let text = format!(
             "distance: {} between triangle {} of A at {:?} and triangle {} of B at {:?} ({}) in {seconds:.6} s",

@@ -2,7 +2,7 @@
 //! rules ask for.
 
 use super::print::{self, out};
-use super::{human_seconds, Failure};
+use super::{human_seconds, Failure, WithContext};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use obbtree::scene::{load, Answer, EventKind, FrameReader, LoadedScene, Scene, Summary};
@@ -100,7 +100,7 @@ type FramesInput = (Box<dyn BufRead>, String, Option<u64>);
 
 fn open_frames(path: PathBuf) -> Result<FramesInput, Failure> {
     let name = path.display().to_string();
-    let file = std::fs::File::open(&path).map_err(|e| Failure(format!("{name}: {e}")))?;
+    let file = std::fs::File::open(&path).with_context(|| &name)?;
     let size = file.metadata().ok().map(|m| m.len());
     Ok((Box::new(BufReader::new(file)), name, size))
 }

@@ -1,7 +1,7 @@
 //! `obbtree verify`: the full O(n) integrity check.
 
 use super::print::out;
-use super::Failure;
+use super::{Failure, WithContext};
 use clap::Args;
 use obbtree::format::ObbtFile;
 use std::path::PathBuf;
@@ -21,7 +21,7 @@ pub struct VerifyArgs {
 pub fn run(args: &VerifyArgs) -> Result<(), Failure> {
     let file = ObbtFile::open(&args.file)?;
     file.verify()
-        .map_err(|e| Failure(format!("{}: verify failed: {e}", args.file.display())))?;
+        .with_context(|| format!("{}: verify failed", args.file.display()))?;
     let info = file.info();
     out!(
         "{}: ok ({} triangles, {} nodes)",

@@ -69,21 +69,12 @@ pub enum ExperimentError {
     /// A tree could not be built.
     #[error(transparent)]
     Build(#[from] BuildError),
-    /// A workload's tree could not be built.
-    #[error("scene {workload}: {source}")]
-    Workload {
-        /// The workload's name (a mesh's file name).
-        workload: String,
-        /// Why.
-        #[source]
-        source: BuildError,
-    },
     /// A query failed.
     #[error(transparent)]
     Query(#[from] QueryError),
     /// A tree's levels could not be measured (a bug: the experiments' trees are sound).
-    #[error("measuring a tree's levels: {0}")]
-    Levels(crate::format::VerifyError),
+    #[error("measuring a tree's levels")]
+    Levels(#[source] crate::format::VerifyError),
 }
 
 /// How the trees are built and their volumes tested, beyond the volume type: today's

@@ -1,5 +1,6 @@
 //! What can be wrong with a `.obbt` file, precisely enough to act on.
 
+use std::fmt;
 use std::path::PathBuf;
 
 /// A file or buffer that `open` (the O(1) header and directory checks) refuses, or a view of
@@ -82,11 +83,16 @@ pub enum FormatError {
 }
 
 /// A file that could not be opened: its path and why.
-#[derive(Debug, thiserror::Error)]
+///
+/// The message is `path: cause`, the cause's text included (callers that keep only the
+/// message, such as a scene's error lines, show it), so `source()` does not return the
+/// cause too: a printer of the whole chain would show it twice. The cause stays in the
+/// variant's `source` field. (thiserror would return a field named `source` from
+/// `source()`, hence the hand-written impls.)
+#[derive(Debug)]
 #[non_exhaustive]
 pub enum OpenError {
     /// The operating system refused to open or map the file.
-    #[error("{path}: {source}")]
     Io {
         /// The file.
         path: PathBuf,
@@ -94,7 +100,6 @@ pub enum OpenError {
         source: std::io::Error,
     },
     /// The bytes are not a valid `.obbt` header and directory.
-    #[error("{path}: {source}")]
     Format {
         /// The file.
         path: PathBuf,
@@ -102,6 +107,18 @@ pub enum OpenError {
         source: FormatError,
     },
 }
+
+impl fmt::Display for OpenError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            OpenError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            OpenError::Format { path, source } => write!(f, "{}: {source}", path.display()),
+        }
+    }
+}
+
+/// No `source()`: the cause's text is in the message (see [`OpenError`]).
+impl std::error::Error for OpenError {}
 
 /// The first problem the O(n) verification found, with the section (or region) it is in.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

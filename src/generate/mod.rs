@@ -52,6 +52,6 @@ pub enum GenerateError {
         count: f64,
     },
     /// The mesh failed its own checks (a bug: the shapes are made valid).
-    #[error("the generated mesh is invalid: {0}")]
+    #[error("the generated mesh is invalid")]
     Mesh(#[from] MeshError),
 }

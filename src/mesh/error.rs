@@ -57,20 +57,25 @@ impl fmt::Display for Place {
 
 /// Why a mesh could not be loaded or built. Each message is one line naming
 /// the input and, where there is one, the line or byte offset at fault.
-#[derive(Debug, thiserror::Error)]
+///
+/// [`MeshError::Io`]'s message ends with the OS error's text (callers that keep only
+/// the message, such as a scene's error lines, show it), so [`source`] does not return
+/// that error too: a printer of the whole chain would show it twice. It stays in the
+/// variant's `source` field. (thiserror would return a field named `source` from
+/// [`source`], hence the hand-written impls.)
+///
+/// [`source`]: std::error::Error::source
+#[derive(Debug)]
 #[non_exhaustive]
 pub enum MeshError {
     /// The file could not be read (missing, unreadable, a directory, ...).
-    #[error("{file}: cannot read: {source}")]
     Io {
         /// The path as given.
         file: String,
         /// The OS error.
-        #[source]
         source: std::io::Error,
     },
     /// The extension is neither `.obj` nor `.stl` and the content looks like neither.
-    #[error("{file}: unknown mesh format: {reason}")]
     UnknownFormat {
         /// The path as given.
         file: String,
@@ -78,7 +83,6 @@ pub enum MeshError {
         reason: String,
     },
     /// A malformed statement or token in a text format (OBJ, ASCII STL).
-    #[error("{place}: {message}")]
     Syntax {
         /// The input and line.
         place: Place,
@@ -86,7 +90,6 @@ pub enum MeshError {
         message: String,
     },
     /// A face refers to a vertex that does not exist.
-    #[error("{place}: face index {index} out of range ({vertex_count} vertices)")]
     IndexOutOfRange {
         /// The input and line (OBJ) or face id ([`TriMesh::new`](super::TriMesh::new)).
         place: Place,
@@ -97,7 +100,6 @@ pub enum MeshError {
         vertex_count: usize,
     },
     /// A vertex coordinate is NaN or infinite (also: a decimal too large for f64).
-    #[error("{place}: non-finite vertex coordinate {value}")]
     NonFinite {
         /// The input and line, byte offset or vertex id.
         place: Place,
@@ -105,13 +107,11 @@ pub enum MeshError {
         value: f64,
     },
     /// The mesh has no vertices (e.g. an empty file).
-    #[error("{file}: empty mesh (no vertices)")]
     EmptyMesh {
         /// The input name.
         file: String,
     },
     /// The mesh has vertices but no faces.
-    #[error("{file}: no faces ({vertex_count} vertices but not a single triangle)")]
     NoFaces {
         /// The input name.
         file: String,
@@ -120,7 +120,6 @@ pub enum MeshError {
     },
     /// A binary STL whose length disagrees with its triangle count (truncated,
     /// trailing data, or too short for the 84-byte header).
-    #[error("{file}: {}", describe_stl_length(*.triangles, *.expected_len, *.actual_len))]
     BinaryStlLength {
         /// The input name.
         file: String,
@@ -133,7 +132,6 @@ pub enum MeshError {
     },
     /// A count above the crate's caps ([`MAX_VERTICES`](super::MAX_VERTICES),
     /// [`MAX_TRIANGLES`](super::MAX_TRIANGLES)).
-    #[error("{file}: too many {what}: {count} (limit {limit})")]
     TooLarge {
         /// The input name.
         file: String,
@@ -145,6 +143,52 @@ pub enum MeshError {
         limit: u64,
     },
 }
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MeshError::Io { file, source } => write!(f, "{file}: cannot read: {source}"),
+            MeshError::UnknownFormat { file, reason } => {
+                write!(f, "{file}: unknown mesh format: {reason}")
+            }
+            MeshError::Syntax { place, message } => write!(f, "{place}: {message}"),
+            MeshError::IndexOutOfRange {
+                place,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "{place}: face index {index} out of range ({vertex_count} vertices)"
+            ),
+            MeshError::NonFinite { place, value } => {
+                write!(f, "{place}: non-finite vertex coordinate {value}")
+            }
+            MeshError::EmptyMesh { file } => write!(f, "{file}: empty mesh (no vertices)"),
+            MeshError::NoFaces { file, vertex_count } => write!(
+                f,
+                "{file}: no faces ({vertex_count} vertices but not a single triangle)"
+            ),
+            MeshError::BinaryStlLength {
+                file,
+                triangles,
+                expected_len,
+                actual_len,
+            } => {
+                let why = describe_stl_length(*triangles, *expected_len, *actual_len);
+                write!(f, "{file}: {why}")
+            }
+            MeshError::TooLarge {
+                file,
+                what,
+                count,
+                limit,
+            } => write!(f, "{file}: too many {what}: {count} (limit {limit})"),
+        }
+    }
+}
+
+/// No `source()`: every cause's text is in the message (see [`MeshError`]).
+impl std::error::Error for MeshError {}
 
 /// The explanation of a [`MeshError::BinaryStlLength`].
 fn describe_stl_length(triangles: Option<u32>, expected: u64, actual: u64) -> String {

@@ -20,9 +20,10 @@
 //! # max_distance = 0.5           # optional for distance
 //! ```
 
+use super::builder::{Item, SceneBuilder};
 use super::error::{line_of, SceneError};
 use super::rules::Effect;
-use super::simulate::{Item, Scene, SceneBuilder};
+use super::simulate::Scene;
 use crate::build::{build, BuildOptions};
 use crate::format::layout::SIGNATURE;
 use crate::format::ObbtFile;
@@ -101,11 +102,11 @@ pub struct LoadedScene {
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
     let source = path.display().to_string();
     let fail = |m: String| SceneError::new(&source, m);
-    let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()))?;
+    let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()).caused_by(e))?;
     let mut text = String::new();
     file.take(MAX_SCENE_BYTES + 1)
         .read_to_string(&mut text)
-        .map_err(|e| fail(format!("cannot read: {e}")))?;
+        .map_err(|e| fail(format!("cannot read: {e}")).caused_by(e))?;
     if text.len() as u64 > MAX_SCENE_BYTES {
         return Err(fail(format!("larger than {MAX_SCENE_BYTES} bytes")));
     }
@@ -120,12 +121,12 @@ fn parse(text: &str, source: &str, base: &Path) -> Result<LoadedScene, SceneErro
         SceneError::new(source, m).at_line(at(span)).in_field(field)
     };
     let spec: SceneToml = toml::from_str(text).map_err(|e| {
-        let message = e.message().trim().to_owned();
-        let located = SceneError::new(source, message);
-        match e.span() {
+        let located = SceneError::new(source, e.message().trim());
+        let located = match e.span() {
             Some(span) => located.at_line(at(span)),
             None => located,
-        }
+        };
+        located.caused_by(e)
     })?;
     if spec.object.len() > MAX_OBJECTS || spec.rule.len() > MAX_RULES {
         let m = format!("at most {MAX_OBJECTS} objects and {MAX_RULES} rules");
@@ -149,7 +150,7 @@ fn parse(text: &str, source: &str, base: &Path) -> Result<LoadedScene, SceneErro
             Some(p) => {
                 let parsed = pose_format
                     .parse(p.get_ref(), spec.orthonormalize)
-                    .map_err(|e| error(p.span(), field("pose"), e.to_string()))?;
+                    .map_err(|e| error(p.span(), field("pose"), e.to_string()).caused_by(e))?;
                 parsed.pose
             }
         };
@@ -286,12 +287,12 @@ fn open_assets(
             let field = format!("object {}, field asset", k + 1);
             let fail = |m: String| error(o.asset.span(), field.clone(), m);
             let identity = std::fs::canonicalize(&path)
-                .map_err(|e| fail(format!("{}: {e}", path.display())))?;
+                .map_err(|e| fail(format!("{}: {e}", path.display())).caused_by(e))?;
             if opened.contains_key(&identity) {
                 continue;
             }
             let file = if pass_trees {
-                let file = ObbtFile::open(&path).map_err(|e| fail(e.to_string()))?;
+                let file = ObbtFile::open(&path).map_err(|e| fail(e.to_string()).caused_by(e))?;
                 if !kind_set {
                     options.bv = file.bv_kind();
                     options.precision = file.precision();
@@ -299,9 +300,9 @@ fn open_assets(
                 }
                 file
             } else {
-                let mesh = TriMesh::load(&path).map_err(|e| fail(e.to_string()))?;
+                let mesh = TriMesh::load(&path).map_err(|e| fail(e.to_string()).caused_by(e))?;
                 build(&mesh, &options, None)
-                    .map_err(|e| fail(format!("{}: {e}", path.display())))?
+                    .map_err(|e| fail(format!("{}: {e}", path.display())).caused_by(e))?
             };
             opened.insert(identity, Arc::new(file));
         }

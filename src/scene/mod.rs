@@ -34,18 +34,26 @@
 //! ```
 
 pub mod broad;
+mod builder;
 mod error;
 mod file;
-mod frames;
+mod frame;
+mod frame_reader;
+mod narrow;
+mod object;
 mod report;
 mod rules;
+mod schedule;
 mod simulate;
 
+pub use builder::SceneBuilder;
 pub use error::SceneError;
 pub use file::{load, LoadedScene};
-pub use frames::FrameReader;
+pub use frame::Frame;
+pub use frame_reader::FrameReader;
+pub use object::SceneObject;
 pub use report::{
     Answer, EffectWork, Event, EventKind, FrameReport, NarrowWork, ObjectId, PairReport, Summary,
 };
-pub use rules::Effect;
-pub use simulate::{Frame, Rule, Scene, SceneBuilder, SceneObject};
+pub use rules::{Effect, Rule};
+pub use simulate::Scene;

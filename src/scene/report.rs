@@ -33,8 +33,9 @@ pub enum Answer {
         /// Triangle of the second object.
         tri_b: u32,
     },
-    /// `distance` with `max_distance`: at least that far apart.
-    Far,
+    /// `distance` with `max_distance`: at least `max_distance` apart, so no distance was
+    /// computed. JSON writes it `"far": true`.
+    Beyond,
     /// `span`: the largest distance between the two.
     Span(f64),
 }
@@ -46,7 +47,7 @@ impl Answer {
             Answer::Contact => "contact",
             Answer::Contacts(_) => "contacts",
             Answer::Closer { .. } => "clearance",
-            Answer::Distance { .. } | Answer::Far => "distance",
+            Answer::Distance { .. } | Answer::Beyond => "distance",
             Answer::Span(_) => "span",
         }
     }
@@ -94,7 +95,7 @@ impl Answer {
                 put("tri_a", json!(tri_a));
                 put("tri_b", json!(tri_b));
             }
-            Answer::Far => put("far", json!(true)),
+            Answer::Beyond => put("far", json!(true)),
             Answer::Span(span) => put("span", json!(span)),
         }
     }
@@ -345,15 +346,15 @@ pub struct Summary {
     pub objects: u64,
     /// Pairs of distinct objects whose effect is not `none`.
     pub pairs_with_effect: u64,
-    /// Pair-frames the broad phase proved empty (no contact, not closer, far) without a
-    /// narrow query, summed over frames.
+    /// Pair-frames the broad phase proved empty (no contact, not closer, beyond
+    /// `max_distance`) without a narrow query, summed over frames.
     pub culled: u64,
     /// Pair-frames answered by reusing the previous answer (neither object moved).
     pub reused: u64,
     /// Narrow-phase queries and their work, by effect.
     pub narrow: NarrowWork,
     /// Narrow queries that stopped early: a first contact found, a clearance violated,
-    /// or a limited distance found far.
+    /// or a limited distance found beyond its `max_distance`.
     pub early_exits: u64,
     /// Distance queries started from the previous frame's witness pair.
     pub warm_starts: u64,

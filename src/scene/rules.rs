@@ -19,11 +19,24 @@ pub enum Effect {
     Distance {
         /// Relative error allowed (0: exact).
         rel_err: f64,
-        /// Beyond this distance the answer is "far" and no exact value is computed.
+        /// At this distance or more the answer is [`Answer::Beyond`](super::Answer::Beyond)
+        /// and no exact value is computed.
         max_distance: Option<f64>,
     },
     /// The span: the largest distance between the two.
     Span,
+}
+
+/// A rule: pairs of an object matched by `a` and one matched by `b` (in either order) get
+/// `effect`. A side is an object name, a group name, or `*` (every object).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rule {
+    /// First side.
+    pub a: String,
+    /// Second side.
+    pub b: String,
+    /// What the pairs ask for.
+    pub effect: Effect,
 }
 
 /// How near two objects must be for an effect to need the narrow phase.

@@ -1,5 +1,12 @@
 //! Meshes generated in code, shared by the integration tests.
 #![allow(dead_code)]
+// Fixtures are made from known-good inputs: one that fails is a failed test, not an input.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
 
 // Integration tests only: the binary's path is known to them at compile time.
 #[cfg(test)]

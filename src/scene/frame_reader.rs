@@ -1,8 +1,9 @@
 //! Frames as JSON Lines, streamed: `{"poses": {"link2": [12 numbers], ...}}` per line.
 
 use super::error::SceneError;
+use super::frame::Frame;
 use super::report::ObjectId;
-use super::simulate::{Frame, Scene};
+use super::simulate::Scene;
 use crate::query::PoseFormat;
 use rustc_hash::FxHashMap;
 use serde::Deserialize;
@@ -78,7 +79,7 @@ impl<R: BufRead> FrameReader<R> {
         match read {
             Ok(0) => return None,
             Ok(n) => self.bytes += n as u64,
-            Err(e) => return Some(Err(self.error(format!("cannot read: {e}")))),
+            Err(e) => return Some(Err(self.error(format!("cannot read: {e}")).caused_by(e))),
         }
         if self.buffer.len() as u64 > MAX_FRAME_LINE {
             let m = format!("a frame line is longer than {MAX_FRAME_LINE} bytes");
@@ -93,8 +94,8 @@ impl<R: BufRead> FrameReader<R> {
         if text.iter().all(u8::is_ascii_whitespace) {
             return Err(self.error(r#"empty line (a frame that moves nothing is {"poses": {}})"#));
         }
-        let line: FrameLine =
-            serde_json::from_slice(text).map_err(|e| self.error(format!("not a frame: {e}")))?;
+        let line: FrameLine = serde_json::from_slice(text)
+            .map_err(|e| self.error(format!("not a frame: {e}")).caused_by(e))?;
         let mut frame = Frame::new();
         for (name, values) in &line.poses {
             let field = format!("poses.{name}");
@@ -105,7 +106,7 @@ impl<R: BufRead> FrameReader<R> {
             let parsed = self
                 .format
                 .parse(values, self.repair)
-                .map_err(|e| self.error(e.to_string()).in_field(field))?;
+                .map_err(|e| self.error(e.to_string()).in_field(field).caused_by(e))?;
             frame.set(id, parsed.pose);
         }
         Ok(frame)
