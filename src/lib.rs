@@ -94,3 +94,9 @@ pub mod real;
 pub mod scene;
 pub mod stats;
 pub mod tree;
+
+/// The README's Rust examples, compiled and run as doctests so they cannot drift from the
+/// API.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -7,6 +7,8 @@
 //! case, spaces made `-`, punctuation other than `-` and `_` dropped, `-1`, `-2`, ...
 //! appended to repeated slugs). Links with a scheme (`https:`, `mailto:`) are not
 //! followed: no network. Code blocks and code spans are not read.
+// Test code outside `#[test]` functions (the Markdown scanner): a failure is a failed test.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;

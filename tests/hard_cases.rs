@@ -10,7 +10,7 @@
 //!   one triangle piercing another through an edge;
 //! - near-contact gaps from 1e-1 down to 1e-9 of the model size (1e-5 for f32 files) at
 //!   model scales 1e-3, 1 and 1e3 and offsets of 1e6: contact flips exactly when the gap
-//!   closes and the distance error stays within the bound documented in the README;
+//!   closes and the distance error stays within the bound documented in docs/DESIGN.md (Accuracy);
 //! - a million eccentric slivers, and the cube (the covariance fit's worst case, §3.5.2).
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::unwrap_used)]
@@ -676,7 +676,7 @@ fn triangles_touching_at_a_vertex_along_an_edge_and_piercing_through_an_edge() {
 // Near contact: scales, offsets, gaps
 // ---------------------------------------------------------------------------------------
 
-/// The documented bound on the distance error (README, "Accuracy"): a few units in the
+/// The documented bound on the distance error (docs/DESIGN.md, "Accuracy"): a few units in the
 /// last place of the largest coordinate magnitude the query computes with, i.e. of model
 /// B's coordinates after they are mapped into model A's frame.
 fn distance_error_bound(magnitude: f64) -> f64 {
@@ -779,7 +779,7 @@ fn near_contact_gaps_flip_contact_exactly_and_keep_the_distance_error_bound() {
             for offset_in_pose in [true, false] {
                 for precision in Precision::ALL {
                     // f32 coordinates 1e6 from the origin cannot hold a model: the offset
-                    // belongs in the pose (README, "Accuracy").
+                    // belongs in the pose (docs/DESIGN.md, "Accuracy").
                     if precision == Precision::F32 && o != 0.0 && !offset_in_pose {
                         continue;
                     }

@@ -4,7 +4,7 @@
 //! segfault) or a hang (each run has a 60 s deadline, far above its few milliseconds).
 //!
 //! The number of damaged files and meshes defaults to 300 each; the environment variable
-//! `OBBTREE_HOSTILE_RUNS` sets it (the README quotes a run of 5,000).
+//! `OBBTREE_HOSTILE_RUNS` sets it (docs/DEVELOPMENT.md quotes a long run).
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 

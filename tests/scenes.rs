@@ -69,7 +69,7 @@ fn concentric_spheres_distance_matches_brute_force() {
 
 /// How often an f32 file's contacts differ from an f64 brute force over the input mesh in
 /// the world frame, and that every difference is a pair within a few f32 ulps of touching.
-/// Run with `--nocapture` to see the counts (quoted in the README).
+/// Run with `--nocapture` to see the counts (quoted in docs/BENCHMARKS.md).
 #[test]
 fn f32_contacts_differ_from_f64_brute_force_only_at_touching_pairs() {
     let big = common::uv_sphere(1.0, 21, 40);

@@ -16,6 +16,7 @@ mod scene;
 mod verify;
 
 use clap::{Parser, Subcommand};
+use obbtree::scene::SceneError;
 use std::error::Error;
 use std::fmt::{self, Display};
 use std::process::ExitCode;
@@ -92,14 +93,16 @@ impl<E: Error + Send + Sync + 'static> From<E> for Failure {
 }
 
 /// The whole chain, joined with `: `. Each error in it shows only its own part and leaves
-/// its cause to `source()`, so no text appears twice.
+/// its cause to `source()`, so no text appears twice; a [`SceneError`] is the exception
+/// its doc states (its message is complete, located in the scene file, with the cause's
+/// text), so the chain stops there.
 impl Display for Failure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.error)?;
-        let mut cause = self.error.source();
-        while let Some(error) = cause {
-            write!(f, ": {error}")?;
-            cause = error.source();
+        let mut error: &(dyn Error + 'static) = &*self.error;
+        write!(f, "{error}")?;
+        while let (None, Some(cause)) = (error.downcast_ref::<SceneError>(), error.source()) {
+            write!(f, ": {cause}")?;
+            error = cause;
         }
         Ok(())
     }
