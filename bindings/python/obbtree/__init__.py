@@ -1,0 +1,166 @@
+"""Collision, distance and span queries between posed triangle meshes, with the oriented
+bounding box trees (OBBTrees) of Gottschalk's dissertation.
+
+Build a tree once (``obbtree.build`` or ``obbtree build`` on the command line) into one
+``.obbt`` file; ``obbtree.open`` maps it in constant time wherever queries run. Every query
+takes two trees and their poses — one pose, or a whole batch as one NumPy array — and
+answers all of them in one call, in parallel, with the GIL released::
+
+    import numpy as np, obbtree
+
+    cow = obbtree.build("cow.obj", "cow.obbt")          # once, offline
+    cow = obbtree.open("cow.obbt")                     # memory-mapped, O(1)
+    poses = np.tile(np.eye(4), (1000, 1, 1))
+    poses[:, 0, 3] = np.linspace(0.0, 3.0, 1000)       # B slides along x
+    hit = obbtree.collide(cow, np.eye(4), cow, poses, first_contact=True)
+    hit.contacts                                       # (1000,) int64, 0 or 1
+    d = obbtree.distance(cow, np.eye(4), cow, poses)   # d.distance, d.point_a, ...
+
+A pose is a (4, 4) rigid matrix, 12 numbers (rotation row-major, then translation) or an
+``(R, t)`` pair; a batch is (N, 4, 4) or (N, 12). A world point is ``R @ p + t``.
+
+Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``; classes
+``Tree``, ``Scene`` and the result classes; exceptions ``Error`` and its subclasses
+``MeshError``, ``FormatError``, ``PoseError``, ``SceneError``, ``OptionError``,
+``FileError``.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from ._obbtree import (
+    CollideResult,
+    DistanceResult,
+    Error,
+    FileError,
+    FormatError,
+    MeshError,
+    OptionError,
+    PoseError,
+    Scene,
+    SceneError,
+    SpanResult,
+    Tree,
+    WithinResult,
+    __version__,
+    _build,
+    collide,
+    distance,
+    open,
+    span,
+    within,
+)
+
+__all__ = [
+    "build",
+    "open",
+    "collide",
+    "distance",
+    "within",
+    "span",
+    "Tree",
+    "Scene",
+    "CollideResult",
+    "DistanceResult",
+    "WithinResult",
+    "SpanResult",
+    "Error",
+    "MeshError",
+    "FormatError",
+    "PoseError",
+    "SceneError",
+    "OptionError",
+    "FileError",
+    "__version__",
+]
+
+
+def _mesh_arrays(vertices: Any, faces: Any) -> "tuple[np.ndarray, np.ndarray]":
+    """Vertices as (n, 3) float64 and faces as (m, 3) int64, or MeshError."""
+    try:
+        v = np.ascontiguousarray(vertices, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise MeshError(f"<memory>: vertices are not an array of numbers ({e})") from None
+    f = np.asarray(faces)
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise MeshError(f"<memory>: vertices must be an (n, 3) array, got shape {v.shape}")
+    if f.ndim != 2 or f.shape[1] != 3:
+        raise MeshError(f"<memory>: faces must be an (m, 3) array of vertex indices, got shape {f.shape}")
+    if f.size and f.dtype.kind not in "iu":
+        raise MeshError(f"<memory>: faces must be integer vertex indices, got dtype {f.dtype}")
+    if f.dtype.kind == "u" and f.size and int(f.max()) > np.iinfo(np.int64).max:
+        raise MeshError(f"<memory>: face index {int(f.max())} out of range ({len(v)} vertices)")
+    return v, np.ascontiguousarray(f, dtype=np.int64)
+
+
+def build(
+    mesh: Any,
+    out: Union[str, "os.PathLike[str]", None] = None,
+    *,
+    bv: str = "obb",
+    precision: str = "f32",
+    leaf_size: int = 1,
+    scale: float = 1.0,
+    center: bool = False,
+    fit: str = "hull",
+    hull_min_faces: Optional[int] = None,
+    hull_max_points: Optional[int] = None,
+    model_axes: bool = True,
+    sphere_fit: str = "box-centre",
+    force: bool = False,
+) -> Tree:
+    """Builds the tree of a mesh; with ``out``, writes it there atomically.
+
+    ``mesh`` is a mesh file (``.obj`` or ``.stl``, binary or ASCII: a ``str`` or
+    ``os.PathLike``), a ``(vertices, faces)`` pair of arrays ((n, 3) float, (m, 3) int
+    vertex indices), or anything with ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``).
+    Triangle ids in every query result are the positions in ``faces`` (file order for a
+    mesh file).
+
+    With ``out`` the tree is written to that path (atomically: readers never see a partial
+    file) and the returned ``Tree`` maps it; without, the tree stays in memory. As with
+    ``obbtree build -o``, ``out`` is never the input mesh, and an existing file that is not a
+    ``.obbt`` file is replaced only with ``force=True``.
+
+    Options (those of ``obbtree build``): ``bv`` "obb", "aabb" or "sphere"; ``precision``
+    "f32" or "f64" (stored vertices and volumes; queries compute in f64); ``leaf_size``
+    1 to 128 triangles per leaf; ``scale`` multiplies every coordinate before storing
+    (0.001: millimetres to metres); ``center`` moves the bounding-box centre to the
+    origin (both recorded in ``info["placement"]``; queries work in stored units);
+    ``fit`` "hull", "triangles" or "vertices"; ``hull_min_faces``, ``hull_max_points``,
+    ``model_axes`` and ``sphere_fit`` ("box-centre" or "minimal") as the CLI's flags.
+
+    Runs with the GIL released. Raises ``MeshError`` for a mesh that cannot be loaded or
+    built, ``OptionError`` (a ValueError) for an option out of range, ``FileError`` (an
+    OSError) for a file that cannot be read or written.
+    """
+    options = dict(
+        out=None if out is None else os.fspath(out),
+        bv=bv,
+        precision=precision,
+        fit=fit,
+        leaf_size=leaf_size,
+        scale=scale,
+        center=center,
+        hull_min_faces=hull_min_faces,
+        hull_max_points=hull_max_points,
+        model_axes=model_axes,
+        sphere_fit=sphere_fit,
+        force=force,
+    )
+    if isinstance(mesh, (str, os.PathLike)):
+        return _build(os.fspath(mesh), None, None, **options)
+    if isinstance(mesh, (tuple, list)) and len(mesh) == 2:
+        vertices, faces = _mesh_arrays(mesh[0], mesh[1])
+    elif hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
+        vertices, faces = _mesh_arrays(mesh.vertices, mesh.faces)
+    else:
+        raise TypeError(
+            "build takes a mesh file path, a (vertices, faces) pair, or an object with "
+            f".vertices and .faces (such as a trimesh.Trimesh), not {type(mesh).__name__}"
+        )
+    return _build(None, vertices, faces, **options)

@@ -1,0 +1,755 @@
+//! The pair queries over pose batches: `collide`, `distance`, `within`, `span`.
+//!
+//! Every query copies the poses out of Python, then releases the GIL: it checks them,
+//! makes one `PairQuery` per worker thread, answers every pose in parallel (rayon) and
+//! comes back with plain vectors, which become NumPy arrays when first read.
+
+use crate::errors::{Failure, Kind};
+use crate::poses::RawPoses;
+use crate::tree::Tree;
+use numpy::{PyArray1, PyArrayMethods};
+use obbtree::format::ObbtFile;
+use obbtree::query::{
+    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, QueryError, SpanOptions,
+    ToleranceOptions, Witness, Work,
+};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// `rule=` values: which tree a traversal descends when both can be.
+fn rule(name: &str) -> Result<DescentRule, Failure> {
+    match name {
+        "diameter" => Ok(DescentRule::LargestDiameter),
+        "volume" => Ok(DescentRule::LargestVolume),
+        "area" => Ok(DescentRule::LargestArea),
+        "a" => Ok(DescentRule::AlwaysA),
+        "b" => Ok(DescentRule::AlwaysB),
+        other => Err(Failure::new(
+            Kind::Option,
+            format!("rule {other:?} is not one of diameter, volume, area, a, b"),
+        )),
+    }
+}
+
+/// Thread pools made for `threads=N`, kept for later calls (making one costs far more than
+/// a small batch).
+static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+
+fn pool(threads: usize) -> Result<Arc<rayon::ThreadPool>, Failure> {
+    let mut pools = POOLS
+        .lock()
+        .map_err(|_| Failure::new(Kind::Base, "the thread pool cache is poisoned"))?;
+    if let Some((_, p)) = pools.iter().find(|(n, _)| *n == threads) {
+        return Ok(p.clone());
+    }
+    let made = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Failure::new(Kind::Option, format!("threads={threads}: {e}")))?;
+    let made = Arc::new(made);
+    pools.push((threads, made.clone()));
+    Ok(made)
+}
+
+/// The checked `threads=` argument.
+fn threads_arg(threads: Option<i64>) -> Result<Option<usize>, Failure> {
+    match threads {
+        None => Ok(None),
+        Some(n) if (1..=1024).contains(&n) => Ok(usize::try_from(n).ok()),
+        Some(n) => Err(Failure::new(
+            Kind::Option,
+            format!("threads must be None or 1 to 1024, got {n}"),
+        )),
+    }
+}
+
+/// Everything a batch needs, owned, so that it runs without the GIL.
+pub struct Batch {
+    a: Arc<ObbtFile>,
+    b: Arc<ObbtFile>,
+    poses_a: RawPoses,
+    poses_b: RawPoses,
+    orthonormalize: bool,
+    threads: Option<usize>,
+}
+
+impl Batch {
+    pub fn new(
+        a: &Tree,
+        poses_a: &Bound<'_, PyAny>,
+        b: &Tree,
+        poses_b: &Bound<'_, PyAny>,
+        orthonormalize: bool,
+        threads: Option<i64>,
+    ) -> PyResult<Batch> {
+        Ok(Batch {
+            a: a.file()?,
+            b: b.file()?,
+            poses_a: RawPoses::extract("poses_a", poses_a)?,
+            poses_b: RawPoses::extract("poses_b", poses_b)?,
+            orthonormalize,
+            threads: threads_arg(threads)?,
+        })
+    }
+
+    /// Answers every pose pair with `query`, in pose order; runs with the GIL released.
+    fn run<T, F>(self, py: Python<'_>, query: F) -> PyResult<Vec<T>>
+    where
+        T: Send,
+        F: Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<T, QueryError> + Send + Sync,
+    {
+        Ok(py.detach(move || self.run_detached(query))?)
+    }
+
+    fn run_detached<T, F>(self, query: F) -> Result<Vec<T>, Failure>
+    where
+        T: Send,
+        F: Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<T, QueryError> + Send + Sync,
+    {
+        let pa = self.poses_a.parse(self.orthonormalize)?;
+        let pb = self.poses_b.parse(self.orthonormalize)?;
+        let (na, nb) = (pa.len(), pb.len());
+        let n = match (self.poses_a.single, self.poses_b.single) {
+            (true, true) => 1,
+            (true, false) => nb,
+            (false, true) => na,
+            (false, false) if na == nb => na,
+            (false, false) => {
+                return Err(Failure::new(
+                    Kind::Pose,
+                    format!(
+                        "poses_a holds {na} poses and poses_b {nb}: give batches of one length, or one pose to broadcast"
+                    ),
+                ))
+            }
+        };
+        let at = |poses: &[Pose], single: bool, i: usize| -> Pose {
+            let k = if single { 0 } else { i };
+            poses.get(k).copied().unwrap_or_default()
+        };
+        let (a, b) = (&*self.a, &*self.b);
+        // Checks the pair once (same volume type and precision), also for an empty batch.
+        let mut first = PairQuery::new(a, b)?;
+        let (sa, sb) = (self.poses_a.single, self.poses_b.single);
+        let one =
+            |pair: &mut PairQuery<'_>, i: usize| query(pair, &at(&pa, sa, i), &at(&pb, sb, i));
+        if n <= 1 || self.threads == Some(1) {
+            return (0..n)
+                .map(|i| one(&mut first, i))
+                .collect::<Result<Vec<T>, QueryError>>()
+                .map_err(Failure::from);
+        }
+        let parallel = || {
+            (0..n)
+                .into_par_iter()
+                .with_min_len(4)
+                .map_init(
+                    || PairQuery::new(a, b),
+                    |pair, i| match pair {
+                        Ok(pair) => one(pair, i),
+                        Err(e) => Err(e.clone()),
+                    },
+                )
+                .collect::<Result<Vec<T>, QueryError>>()
+        };
+        let answers = match self.threads {
+            None => parallel(),
+            Some(k) => pool(k)?.install(parallel),
+        };
+        answers.map_err(Failure::from)
+    }
+}
+
+/// A cached NumPy value of a result, made when first read.
+fn cached<'py>(
+    cell: &PyOnceLock<Py<PyAny>>,
+    py: Python<'py>,
+    make: impl FnOnce() -> PyResult<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let value = cell.get_or_try_init(py, || make().map(Bound::unbind))?;
+    Ok(value.bind(py).clone())
+}
+
+fn readonly<'py>(array: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let kwargs = PyDict::new(array.py());
+    kwargs.set_item("write", false)?;
+    array.call_method("setflags", (), Some(&kwargs))?;
+    Ok(array)
+}
+
+/// The work of each pose as a dict of (N,) int64 arrays, keys as the CLI's `stats`.
+fn work_dict<'py>(py: Python<'py>, work: &[Work]) -> PyResult<Bound<'py, PyAny>> {
+    let dict = PyDict::new(py);
+    let column = |f: fn(&Work) -> u64| -> Vec<i64> {
+        work.iter()
+            .map(|w| i64::try_from(f(w)).unwrap_or(i64::MAX))
+            .collect()
+    };
+    let columns: [(&str, fn(&Work) -> u64); 7] = [
+        ("bv_disjoint", |w| w.bv_disjoint),
+        ("bv_overlap", |w| w.bv_overlap),
+        ("tri_separated", |w| w.tri_separated),
+        ("tri_contact", |w| w.tri_contact),
+        ("nodes_visited", |w| w.nodes_visited),
+        ("bv_tests", |w| w.bv_tests()),
+        ("tri_tests", |w| w.tri_tests()),
+    ];
+    for (name, f) in columns {
+        dict.set_item(
+            name,
+            readonly(PyArray1::from_vec(py, column(f)).into_any())?,
+        )?;
+    }
+    Ok(dict.into_any())
+}
+
+/// The answers of `collide` for N pose pairs.
+///
+/// Attributes: `contacts` (N,) int64 — contacting triangle pairs per pose (0 or 1 with
+/// `first_contact`); `colliding` (N,) bool; `pairs` — a list of N (k, 2) int64 arrays of
+/// input-mesh triangle ids (A's, B's), sorted, or None when called with `pairs=False`;
+/// `work` — a dict of (N,) int64 arrays (bv_disjoint, bv_overlap, tri_separated,
+/// tri_contact, nodes_visited, bv_tests, tri_tests: the CLI's `stats`). Arrays are
+/// read-only.
+#[pyclass(module = "obbtree", name = "CollideResult", frozen)]
+pub struct CollideResult {
+    contacts: Vec<i64>,
+    pairs: Option<Vec<Vec<(u32, u32)>>>,
+    work: Vec<Work>,
+    contacts_array: PyOnceLock<Py<PyAny>>,
+    colliding_array: PyOnceLock<Py<PyAny>>,
+    pairs_list: PyOnceLock<Py<PyAny>>,
+    work_dict: PyOnceLock<Py<PyAny>>,
+}
+
+#[pymethods]
+impl CollideResult {
+    /// (N,) int64: contacting triangle pairs per pose (first_contact: 0 or 1).
+    #[getter]
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        cached(&self.contacts_array, py, || {
+            readonly(PyArray1::from_slice(py, &self.contacts).into_any())
+        })
+    }
+
+    /// (N,) bool: whether the models touch under each pose.
+    #[getter]
+    fn colliding<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        cached(&self.colliding_array, py, || {
+            let c: Vec<bool> = self.contacts.iter().map(|&k| k > 0).collect();
+            readonly(PyArray1::from_vec(py, c).into_any())
+        })
+    }
+
+    /// A list of N (k, 2) int64 arrays: the contacting pairs (triangle of A, triangle of
+    /// B; input-mesh ids), sorted; at most one pair with first_contact. None when the call
+    /// passed pairs=False.
+    #[getter]
+    fn pairs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let Some(pairs) = &self.pairs else {
+            return Ok(py.None().into_bound(py));
+        };
+        cached(&self.pairs_list, py, || {
+            let list = PyList::empty(py);
+            for p in pairs {
+                let flat: Vec<i64> = p
+                    .iter()
+                    .flat_map(|&(x, y)| [i64::from(x), i64::from(y)])
+                    .collect();
+                let array = PyArray1::from_vec(py, flat).reshape([p.len(), 2])?;
+                list.append(readonly(array.into_any())?)?;
+            }
+            Ok(list.into_any())
+        })
+    }
+
+    /// The work per pose: a dict of (N,) int64 arrays with the keys of the CLI's `stats`.
+    #[getter]
+    fn work<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        cached(&self.work_dict, py, || work_dict(py, &self.work))
+    }
+
+    fn __len__(&self) -> usize {
+        self.contacts.len()
+    }
+
+    fn __repr__(&self) -> String {
+        let colliding = self.contacts.iter().filter(|&&k| k > 0).count();
+        format!(
+            "<obbtree.CollideResult: {} poses, {colliding} colliding>",
+            self.contacts.len()
+        )
+    }
+}
+
+/// Witness columns of N answers (distance, within, span).
+struct Witnesses {
+    distance: Vec<f64>,
+    point_a: Vec<f64>,
+    point_b: Vec<f64>,
+    tri_a: Vec<i64>,
+    tri_b: Vec<i64>,
+    work: Vec<Work>,
+}
+
+impl Witnesses {
+    /// Columns of `answers`: (witness or None, work). None gives `missing` as the distance,
+    /// NaN points and triangle -1.
+    fn new(answers: Vec<(Option<Witness>, Work)>, missing: f64) -> Witnesses {
+        let n = answers.len();
+        let mut w = Witnesses {
+            distance: Vec::with_capacity(n),
+            point_a: Vec::with_capacity(3 * n),
+            point_b: Vec::with_capacity(3 * n),
+            tri_a: Vec::with_capacity(n),
+            tri_b: Vec::with_capacity(n),
+            work: Vec::with_capacity(n),
+        };
+        for (witness, work) in answers {
+            match witness {
+                Some(x) => {
+                    w.distance.push(x.distance);
+                    w.point_a.extend_from_slice(x.point_a.as_slice());
+                    w.point_b.extend_from_slice(x.point_b.as_slice());
+                    w.tri_a.push(i64::from(x.tri_a));
+                    w.tri_b.push(i64::from(x.tri_b));
+                }
+                None => {
+                    w.distance.push(missing);
+                    w.point_a.extend_from_slice(&[f64::NAN; 3]);
+                    w.point_b.extend_from_slice(&[f64::NAN; 3]);
+                    w.tri_a.push(-1);
+                    w.tri_b.push(-1);
+                }
+            }
+            w.work.push(work);
+        }
+        w
+    }
+}
+
+/// Lazily made arrays of [`Witnesses`].
+struct WitnessArrays {
+    distance: PyOnceLock<Py<PyAny>>,
+    point_a: PyOnceLock<Py<PyAny>>,
+    point_b: PyOnceLock<Py<PyAny>>,
+    tri_a: PyOnceLock<Py<PyAny>>,
+    tri_b: PyOnceLock<Py<PyAny>>,
+    work: PyOnceLock<Py<PyAny>>,
+}
+
+impl Default for WitnessArrays {
+    fn default() -> Self {
+        WitnessArrays {
+            distance: PyOnceLock::new(),
+            point_a: PyOnceLock::new(),
+            point_b: PyOnceLock::new(),
+            tri_a: PyOnceLock::new(),
+            tri_b: PyOnceLock::new(),
+            work: PyOnceLock::new(),
+        }
+    }
+}
+
+fn column<'py>(
+    cell: &PyOnceLock<Py<PyAny>>,
+    py: Python<'py>,
+    values: &[f64],
+) -> PyResult<Bound<'py, PyAny>> {
+    cached(cell, py, || {
+        readonly(PyArray1::from_slice(py, values).into_any())
+    })
+}
+
+fn ids<'py>(
+    cell: &PyOnceLock<Py<PyAny>>,
+    py: Python<'py>,
+    values: &[i64],
+) -> PyResult<Bound<'py, PyAny>> {
+    cached(cell, py, || {
+        readonly(PyArray1::from_slice(py, values).into_any())
+    })
+}
+
+fn points<'py>(
+    cell: &PyOnceLock<Py<PyAny>>,
+    py: Python<'py>,
+    values: &[f64],
+) -> PyResult<Bound<'py, PyAny>> {
+    cached(cell, py, || {
+        let rows = values.len() / 3;
+        let array = PyArray1::from_slice(py, values).reshape([rows, 3])?;
+        readonly(array.into_any())
+    })
+}
+
+/// Defines the shared witness getters of a result class.
+macro_rules! witness_getters {
+    ($class:ident, $what:literal, { $($extra:tt)* }) => {
+        #[pymethods]
+        impl $class {
+            $($extra)*
+
+            #[doc = concat!("(N, 3) float64: the point on A (world frame) ", $what, "; NaN where there is none.")]
+            #[getter]
+            fn point_a<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                points(&self.arrays.point_a, py, &self.columns.point_a)
+            }
+
+            #[doc = concat!("(N, 3) float64: the point on B (world frame) ", $what, "; NaN where there is none.")]
+            #[getter]
+            fn point_b<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                points(&self.arrays.point_b, py, &self.columns.point_b)
+            }
+
+            #[doc = concat!("(N,) int64: the input-mesh triangle of A holding point_a; -1 where there is none.")]
+            #[getter]
+            fn tri_a<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                ids(&self.arrays.tri_a, py, &self.columns.tri_a)
+            }
+
+            #[doc = concat!("(N,) int64: the input-mesh triangle of B holding point_b; -1 where there is none.")]
+            #[getter]
+            fn tri_b<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                ids(&self.arrays.tri_b, py, &self.columns.tri_b)
+            }
+
+            /// The work per pose: a dict of (N,) int64 arrays with the keys of the CLI's
+            /// `stats`.
+            #[getter]
+            fn work<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                cached(&self.arrays.work, py, || work_dict(py, &self.columns.work))
+            }
+
+            fn __len__(&self) -> usize {
+                self.columns.distance.len()
+            }
+        }
+    };
+}
+
+/// The answers of `distance` for N pose pairs.
+///
+/// Attributes (read-only arrays): `distance` (N,) float64 — the separation distance (0
+/// when touching), exact or within the allowed error, +inf where the models are at least
+/// `max_distance` apart; `point_a`, `point_b` (N, 3) — closest points, world frame (NaN
+/// beyond max_distance); `tri_a`, `tri_b` (N,) int64 — their input-mesh triangles (-1
+/// beyond max_distance); `work` — dict of (N,) int64 arrays.
+#[pyclass(module = "obbtree", name = "DistanceResult", frozen)]
+pub struct DistanceResult {
+    columns: Witnesses,
+    arrays: WitnessArrays,
+}
+
+witness_getters!(DistanceResult, "of the closest pair", {
+    /// (N,) float64: the distance; +inf where at least max_distance apart.
+    #[getter]
+    fn distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        column(&self.arrays.distance, py, &self.columns.distance)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<obbtree.DistanceResult: {} poses>",
+            self.columns.distance.len()
+        )
+    }
+});
+
+/// The answers of `within` for N pose pairs.
+///
+/// Attributes (read-only arrays): `closer` (N,) bool — whether the models come closer than
+/// the tolerance; `distance` (N,) float64 — the distance of the witness pair found (below
+/// the tolerance, not necessarily the least), NaN where not closer; `point_a`, `point_b`
+/// (N, 3), `tri_a`, `tri_b` (N,) int64 — the witness (NaN / -1 where not closer); `work`.
+#[pyclass(module = "obbtree", name = "WithinResult", frozen)]
+pub struct WithinResult {
+    columns: Witnesses,
+    arrays: WitnessArrays,
+    closer: Vec<bool>,
+    closer_array: PyOnceLock<Py<PyAny>>,
+}
+
+witness_getters!(WithinResult, "of the witness pair", {
+    /// (N,) bool: whether the models come closer than the tolerance.
+    #[getter]
+    fn closer<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        cached(&self.closer_array, py, || {
+            readonly(PyArray1::from_slice(py, &self.closer).into_any())
+        })
+    }
+
+    /// (N,) float64: the witness pair's distance (below the tolerance); NaN where not
+    /// closer.
+    #[getter]
+    fn distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        column(&self.arrays.distance, py, &self.columns.distance)
+    }
+
+    fn __repr__(&self) -> String {
+        let closer = self.closer.iter().filter(|&&c| c).count();
+        format!(
+            "<obbtree.WithinResult: {} poses, {closer} closer than the tolerance>",
+            self.closer.len()
+        )
+    }
+});
+
+/// The answers of `span` for N pose pairs.
+///
+/// Attributes (read-only arrays): `span` (N,) float64 — the largest distance between a
+/// point of A and a point of B; `point_a`, `point_b` (N, 3) — the farthest points, world
+/// frame; `tri_a`, `tri_b` (N,) int64 — their input-mesh triangles; `work`.
+#[pyclass(module = "obbtree", name = "SpanResult", frozen)]
+pub struct SpanResult {
+    columns: Witnesses,
+    arrays: WitnessArrays,
+}
+
+witness_getters!(SpanResult, "of the farthest pair", {
+    /// (N,) float64: the span.
+    #[getter]
+    fn span<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        column(&self.arrays.distance, py, &self.columns.distance)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<obbtree.SpanResult: {} poses>",
+            self.columns.distance.len()
+        )
+    }
+});
+
+/// Which triangle pairs touch, for each pose pair of a batch.
+///
+/// a, b: `Tree`s (same volume type and precision). poses_a, poses_b: one pose — a (4, 4)
+/// rigid matrix, 12 numbers (rotation row-major, then translation) or an (R, t) pair — or
+/// a batch (N, 4, 4) or (N, 12) (or (R (N, 3, 3), t (N, 3))). A single pose broadcasts
+/// against a batch; two single poses give N = 1. World point = R p + t.
+///
+/// first_contact: stop at the first contact (a yes/no answer with one witness pair; much
+/// faster). pairs: False skips building the pair lists. threads: None for every core, or
+/// the number of threads for a batch. orthonormalize: replace each rotation by the nearest
+/// rotation (as the CLI's --orthonormalize; changes above 1e-2 are refused); without it a
+/// rotation must be orthonormal within 1e-6. rule: which tree to descend first (diameter,
+/// volume, area, a, b).
+///
+/// Returns a `CollideResult` (contacts, colliding, pairs, work). The batch runs in parallel
+/// with the GIL released. Raises `obbtree.PoseError` (a ValueError) naming the argument and
+/// pose index of a bad pose, `obbtree.Error` for trees of different kinds or a closed tree.
+#[pyfunction]
+#[pyo3(signature = (a, poses_a, b, poses_b, *, first_contact=false, pairs=true, threads=None, orthonormalize=false, rule="diameter"))]
+#[allow(clippy::too_many_arguments)]
+pub fn collide(
+    py: Python<'_>,
+    a: PyRef<'_, Tree>,
+    poses_a: &Bound<'_, PyAny>,
+    b: PyRef<'_, Tree>,
+    poses_b: &Bound<'_, PyAny>,
+    first_contact: bool,
+    pairs: bool,
+    threads: Option<i64>,
+    orthonormalize: bool,
+    rule: &str,
+) -> PyResult<CollideResult> {
+    let options = CollideOptions {
+        first_contact,
+        rule: self::rule(rule)?,
+        ..CollideOptions::default()
+    };
+    let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
+    let answers = batch.run(py, |pair, pa, pb| {
+        let r = pair.collide(pa, pb, &options)?;
+        Ok((r.pairs, r.work))
+    })?;
+    let contacts = answers
+        .iter()
+        .map(|(p, _)| i64::try_from(p.len()).unwrap_or(i64::MAX))
+        .collect();
+    let work = answers.iter().map(|(_, w)| *w).collect();
+    let pair_lists = pairs.then(|| answers.into_iter().map(|(p, _)| p).collect());
+    Ok(CollideResult {
+        contacts,
+        pairs: pair_lists,
+        work,
+        contacts_array: PyOnceLock::new(),
+        colliding_array: PyOnceLock::new(),
+        pairs_list: PyOnceLock::new(),
+        work_dict: PyOnceLock::new(),
+    })
+}
+
+/// The separation distance between the surfaces, with the closest points, for each pose
+/// pair of a batch (poses as for `collide`).
+///
+/// Exact by default; with rel_err / abs_err the answer d satisfies
+/// d* <= d <= max(d* (1 + rel_err), d* + abs_err) for the true distance d*. max_distance:
+/// pairs at least that far apart answer +inf (points NaN, triangles -1) without the work
+/// of finding how far (None: no limit).
+///
+/// Returns a `DistanceResult` (distance, point_a, point_b, tri_a, tri_b, work). Raises
+/// `obbtree.OptionError` (a ValueError) for a negative or non-finite error allowance.
+#[pyfunction]
+#[pyo3(signature = (a, poses_a, b, poses_b, *, rel_err=0.0, abs_err=0.0, max_distance=None, threads=None, orthonormalize=false, rule="diameter"))]
+#[allow(clippy::too_many_arguments)]
+pub fn distance(
+    py: Python<'_>,
+    a: PyRef<'_, Tree>,
+    poses_a: &Bound<'_, PyAny>,
+    b: PyRef<'_, Tree>,
+    poses_b: &Bound<'_, PyAny>,
+    rel_err: f64,
+    abs_err: f64,
+    max_distance: Option<f64>,
+    threads: Option<i64>,
+    orthonormalize: bool,
+    rule: &str,
+) -> PyResult<DistanceResult> {
+    let options = DistanceOptions {
+        rel_err,
+        abs_err,
+        max_distance: max_distance.unwrap_or(f64::INFINITY),
+        rule: self::rule(rule)?,
+        ..DistanceOptions::default()
+    };
+    let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
+    let answers = batch.run(py, |pair, pa, pb| {
+        let r = pair.distance(pa, pb, &options)?;
+        Ok((r.closest, r.work))
+    })?;
+    Ok(DistanceResult {
+        columns: Witnesses::new(answers, f64::INFINITY),
+        arrays: WitnessArrays::default(),
+    })
+}
+
+/// Whether the surfaces come closer than `tolerance`, for each pose pair of a batch (poses
+/// as for `collide`), stopping as soon as it knows: much cheaper than a distance.
+///
+/// Returns a `WithinResult`: closer (N,) bool, and a witness pair closer than the
+/// tolerance where there is one (distance, point_a, point_b, tri_a, tri_b; NaN and -1
+/// elsewhere). Raises `obbtree.OptionError` for a negative or non-finite tolerance.
+#[pyfunction]
+#[pyo3(signature = (a, poses_a, b, poses_b, tolerance, *, threads=None, orthonormalize=false, rule="diameter"))]
+#[allow(clippy::too_many_arguments)]
+pub fn within(
+    py: Python<'_>,
+    a: PyRef<'_, Tree>,
+    poses_a: &Bound<'_, PyAny>,
+    b: PyRef<'_, Tree>,
+    poses_b: &Bound<'_, PyAny>,
+    tolerance: f64,
+    threads: Option<i64>,
+    orthonormalize: bool,
+    rule: &str,
+) -> PyResult<WithinResult> {
+    let options = ToleranceOptions {
+        tolerance,
+        rule: self::rule(rule)?,
+    };
+    let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
+    let answers = batch.run(py, |pair, pa, pb| {
+        let r = pair.within(pa, pb, &options)?;
+        Ok((r.witness, r.work))
+    })?;
+    let closer = answers.iter().map(|(w, _)| w.is_some()).collect();
+    Ok(WithinResult {
+        columns: Witnesses::new(answers, f64::NAN),
+        arrays: WitnessArrays::default(),
+        closer,
+        closer_array: PyOnceLock::new(),
+    })
+}
+
+/// The span: the largest distance between a point of A and a point of B, with the two
+/// farthest points, for each pose pair of a batch (poses as for `collide`).
+///
+/// Returns a `SpanResult` (span, point_a, point_b, tri_a, tri_b, work).
+#[pyfunction]
+#[pyo3(signature = (a, poses_a, b, poses_b, *, threads=None, orthonormalize=false, rule="diameter"))]
+#[allow(clippy::too_many_arguments)]
+pub fn span(
+    py: Python<'_>,
+    a: PyRef<'_, Tree>,
+    poses_a: &Bound<'_, PyAny>,
+    b: PyRef<'_, Tree>,
+    poses_b: &Bound<'_, PyAny>,
+    threads: Option<i64>,
+    orthonormalize: bool,
+    rule: &str,
+) -> PyResult<SpanResult> {
+    let options = SpanOptions {
+        rule: self::rule(rule)?,
+    };
+    let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
+    let answers = batch.run(py, |pair, pa, pb| {
+        let r = pair.span(pa, pb, &options)?;
+        Ok((Some(r.farthest), r.work))
+    })?;
+    Ok(SpanResult {
+        columns: Witnesses::new(answers, f64::NAN),
+        arrays: WitnessArrays::default(),
+    })
+}
+
+/// For measuring the binding's overhead: the seconds per call of `repeat` calls of one
+/// query ("first_contact", "collide", "distance") on pose pair `i % N` of the batch, made
+/// from Rust with one `PairQuery` (no Python in the loop), with the GIL released.
+#[pyfunction]
+pub fn _time_rust_loop(
+    py: Python<'_>,
+    a: PyRef<'_, Tree>,
+    poses_a: &Bound<'_, PyAny>,
+    b: PyRef<'_, Tree>,
+    poses_b: &Bound<'_, PyAny>,
+    query: &str,
+    repeat: usize,
+) -> PyResult<f64> {
+    let (fa, fb) = (a.file()?, b.file()?);
+    let ra = RawPoses::extract("poses_a", poses_a)?;
+    let rb = RawPoses::extract("poses_b", poses_b)?;
+    let query = query.to_owned();
+    let seconds = py.detach(move || -> Result<f64, Failure> {
+        let pa = ra.parse(false)?;
+        let pb = rb.parse(false)?;
+        let n = pa.len().max(pb.len()).max(1);
+        let mut pair = PairQuery::new(&fa, &fb)?;
+        let first = CollideOptions {
+            first_contact: true,
+            ..CollideOptions::default()
+        };
+        let all = CollideOptions::default();
+        let exact = DistanceOptions::default();
+        let pose = |poses: &[Pose], i: usize| {
+            poses
+                .get(i % poses.len().max(1))
+                .copied()
+                .unwrap_or_default()
+        };
+        let started = Instant::now();
+        let mut sink = 0usize;
+        for i in 0..repeat {
+            let (x, y) = (pose(&pa, i % n), pose(&pb, i % n));
+            sink += match query.as_str() {
+                "first_contact" => pair.collide(&x, &y, &first)?.pairs.len(),
+                "collide" => pair.collide(&x, &y, &all)?.pairs.len(),
+                "distance" => usize::from(pair.distance(&x, &y, &exact)?.closest.is_some()),
+                other => {
+                    return Err(Failure::new(
+                        Kind::Option,
+                        format!("query {other:?} is not first_contact, collide or distance"),
+                    ))
+                }
+            };
+        }
+        let elapsed = started.elapsed().as_secs_f64();
+        std::hint::black_box(sink);
+        Ok(elapsed / repeat.max(1) as f64)
+    })?;
+    Ok(seconds)
+}
