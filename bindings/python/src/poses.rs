@@ -2,7 +2,7 @@
 //! takes), checked by the library's rules (those of the CLI).
 
 use crate::errors::{Failure, Kind};
-use numpy::{AllowTypeChange, PyArrayLikeDyn};
+use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods};
 use obbtree::query::{Pose, PoseFormat};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -54,29 +54,44 @@ fn array<'py>(
         .map_err(|e| bad(name, format!("not an array of numbers ({e}); {SHAPES}")))
 }
 
+/// The shape and the numbers (row-major) of an array argument, copied out at once.
+fn numbers(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<usize>, Vec<f64>)> {
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        // SAFETY: the array is read while this thread holds the GIL (no Python code runs)
+        // and copied at once; this extension never makes a writable view of an array it is
+        // given, so nothing else writes to it meanwhile. (This skips rust-numpy's borrow
+        // tracking, which costs more than the copy for one pose.)
+        let view = unsafe { a.as_array() };
+        let values = view
+            .as_slice()
+            .map(<[f64]>::to_vec)
+            .unwrap_or_else(|| view.iter().copied().collect());
+        return Ok((view.shape().to_vec(), values));
+    }
+    let a = array(name, obj)?;
+    let view = a.as_array();
+    // Iterates in logical (row-major) order whatever the strides.
+    Ok((view.shape().to_vec(), view.iter().copied().collect()))
+}
+
 impl RawPoses {
     /// Reads the pose argument `name`: (4, 4), (12,), (R, t), (N, 4, 4), (N, 12), or a
     /// batch pair (R (N, 3, 3), t (N, 3)).
     pub fn extract(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<RawPoses> {
         if let Ok(pair) = obj.cast::<PyTuple>() {
             if pair.len() == 2 {
-                return RawPoses::rotation_translation(
-                    name,
-                    &pair.get_item(0)?,
-                    &pair.get_item(1)?,
-                );
+                let rt =
+                    RawPoses::rotation_translation(name, &pair.get_item(0)?, &pair.get_item(1)?);
+                // Not an (R, t) pair: maybe a tuple of two poses, a batch like any sequence.
+                return rt.or_else(|e| RawPoses::array(name, obj).map_err(|_| e));
             }
-            return Err(bad(
-                name,
-                format!(
-                    "a tuple of {} items is not an (R, t) pair; {SHAPES}",
-                    pair.len()
-                ),
-            ));
         }
-        let a = array(name, obj)?;
-        let view = a.as_array();
-        let shape = view.shape().to_vec();
+        RawPoses::array(name, obj)
+    }
+
+    /// Reads a pose or batch given as one array: (4, 4), (12,), (N, 4, 4) or (N, 12).
+    fn array(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<RawPoses> {
+        let (shape, values) = numbers(name, obj)?;
         let (format, count, single) = match shape.as_slice() {
             [4, 4] => (PoseFormat::Matrix4, 1, true),
             [12] => (PoseFormat::RotationTranslation, 1, true),
@@ -92,8 +107,6 @@ impl RawPoses {
                 ))
             }
         };
-        // Iterates in logical (row-major) order whatever the strides.
-        let values: Vec<f64> = view.iter().copied().collect();
         Ok(RawPoses {
             name: name.to_owned(),
             values,
@@ -108,9 +121,8 @@ impl RawPoses {
         r: &Bound<'_, PyAny>,
         t: &Bound<'_, PyAny>,
     ) -> PyResult<RawPoses> {
-        let (r, t) = (array(name, r)?, array(name, t)?);
-        let (r, t) = (r.as_array(), t.as_array());
-        let (count, single) = match (r.shape(), t.shape()) {
+        let ((r_shape, r), (t_shape, t)) = (numbers(name, r)?, numbers(name, t)?);
+        let (count, single) = match (r_shape.as_slice(), t_shape.as_slice()) {
             ([3, 3], [3]) => (1, true),
             ([n, 3, 3], [m, 3]) if n == m => (*n, false),
             (rs, ts) => {
@@ -124,8 +136,6 @@ impl RawPoses {
                 ))
             }
         };
-        let r: Vec<f64> = r.iter().copied().collect();
-        let t: Vec<f64> = t.iter().copied().collect();
         let mut values = Vec::with_capacity(12 * count);
         for (rotation, translation) in r.chunks_exact(9).zip(t.chunks_exact(3)) {
             values.extend_from_slice(rotation);

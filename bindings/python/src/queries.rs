@@ -10,13 +10,14 @@ use crate::tree::Tree;
 use numpy::{PyArray1, PyArrayMethods};
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, QueryError, SpanOptions,
-    ToleranceOptions, Witness, Work,
+    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, QueryContext, QueryError,
+    SpanOptions, ToleranceOptions, Witness, Work,
 };
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
+use std::cell::RefCell;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -133,34 +134,72 @@ impl Batch {
         };
         let (a, b) = (&*self.a, &*self.b);
         // Checks the pair once (same volume type and precision), also for an empty batch.
-        let mut first = PairQuery::new(a, b)?;
+        let mut first = Pooled::new(a, b)?;
         let (sa, sb) = (self.poses_a.single, self.poses_b.single);
-        let one =
-            |pair: &mut PairQuery<'_>, i: usize| query(pair, &at(&pa, sa, i), &at(&pb, sb, i));
+        let one = |pooled: &mut Pooled<'_>, i: usize| -> Result<T, Failure> {
+            let pair = pooled.pair()?;
+            Ok(query(pair, &at(&pa, sa, i), &at(&pb, sb, i))?)
+        };
         if n <= 1 || self.threads == Some(1) {
-            return (0..n)
-                .map(|i| one(&mut first, i))
-                .collect::<Result<Vec<T>, QueryError>>()
-                .map_err(Failure::from);
+            return (0..n).map(|i| one(&mut first, i)).collect();
         }
+        drop(first);
         let parallel = || {
             (0..n)
                 .into_par_iter()
                 .with_min_len(4)
                 .map_init(
-                    || PairQuery::new(a, b),
-                    |pair, i| match pair {
-                        Ok(pair) => one(pair, i),
-                        Err(e) => Err(e.clone()),
+                    || Pooled::new(a, b),
+                    |pooled, i| match pooled {
+                        Ok(pooled) => one(pooled, i),
+                        Err(e) => Err(Failure::from(e.clone())),
                     },
                 )
-                .collect::<Result<Vec<T>, QueryError>>()
+                .collect::<Result<Vec<T>, Failure>>()
         };
-        let answers = match self.threads {
+        match self.threads {
             None => parallel(),
             Some(k) => pool(k)?.install(parallel),
-        };
-        answers.map_err(Failure::from)
+        }
+    }
+}
+
+thread_local! {
+    /// Traversal scratch kept per thread between calls, so that a query's buffers grow to
+    /// its traversal's size once per thread, not once per call.
+    static SCRATCH: RefCell<Option<QueryContext>> = const { RefCell::new(None) };
+}
+
+/// A `PairQuery` made with this thread's kept scratch, which it gives back when dropped.
+struct Pooled<'f>(Option<PairQuery<'f>>);
+
+impl<'f> Pooled<'f> {
+    fn new(a: &'f ObbtFile, b: &'f ObbtFile) -> Result<Pooled<'f>, QueryError> {
+        let context = SCRATCH
+            .try_with(|s| s.try_borrow_mut().ok().and_then(|mut s| s.take()))
+            .ok()
+            .flatten()
+            .unwrap_or_default();
+        Ok(Pooled(Some(PairQuery::with_context(a, b, context)?)))
+    }
+
+    fn pair(&mut self) -> Result<&mut PairQuery<'f>, Failure> {
+        self.0
+            .as_mut()
+            .ok_or_else(|| Failure::new(Kind::Base, "the pair query was released"))
+    }
+}
+
+impl Drop for Pooled<'_> {
+    fn drop(&mut self) {
+        if let Some(pair) = self.0.take() {
+            let context = pair.into_context();
+            let _ = SCRATCH.try_with(|s| {
+                if let Ok(mut s) = s.try_borrow_mut() {
+                    *s = Some(context);
+                }
+            });
+        }
     }
 }
 
