@@ -354,8 +354,8 @@ enum ObbtreeStatus obbtree_pair_distance(struct ObbtreePair *pair,
                                          double max_distance,
                                          struct ObbtreeDistanceResult *out);
 
-// Whether A at `pose_a` and B at `pose_b` come closer than `tolerance` (world units,
-// >= 0), stopping as soon as that is known; with `closer`, a pair closer than the
+// Whether A at `pose_a` and B at `pose_b` come closer than `tolerance` (world units, at
+// least 0), stopping as soon as that is known; with `closer`, a pair closer than the
 // tolerance. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite tolerance.
 //
 // # Safety

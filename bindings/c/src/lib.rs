@@ -21,7 +21,11 @@
 //! Threads: an [`ObbtreeTree`] may be used by any number of threads at once. An
 //! [`ObbtreePair`] is used by one thread at a time (it holds the traversal scratch); a
 //! second thread calling into a handle in use gets `OBBTREE_STATUS_BUSY`, never a race.
-#![deny(unsafe_op_in_unsafe_fn, missing_docs, clippy::undocumented_unsafe_blocks)]
+#![deny(
+    unsafe_op_in_unsafe_fn,
+    missing_docs,
+    clippy::undocumented_unsafe_blocks
+)]
 
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
@@ -1034,8 +1038,8 @@ pub unsafe extern "C" fn obbtree_pair_distance(
     })
 }
 
-/// Whether A at `pose_a` and B at `pose_b` come closer than `tolerance` (world units,
-/// >= 0), stopping as soon as that is known; with `closer`, a pair closer than the
+/// Whether A at `pose_a` and B at `pose_b` come closer than `tolerance` (world units, at
+/// least 0), stopping as soon as that is known; with `closer`, a pair closer than the
 /// tolerance. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite tolerance.
 ///
 /// # Safety
@@ -1167,8 +1171,12 @@ impl<'a> Batch<'a> {
         };
         let (len_a, len_b) = (numbers(count_a, "poses_a")?, numbers(count_b, "poses_b")?);
         // SAFETY: NULL or 12 * count doubles each (the caller's contract).
-        let (values_a, values_b) =
-            unsafe { (slice(poses_a, len_a, "poses_a")?, slice(poses_b, len_b, "poses_b")?) };
+        let (values_a, values_b) = unsafe {
+            (
+                slice(poses_a, len_a, "poses_a")?,
+                slice(poses_b, len_b, "poses_b")?,
+            )
+        };
         // Checked once here: every worker can then make its own pair without failing.
         PairQuery::new(&a.file, &b.file)?;
         Ok(Batch {
@@ -1194,9 +1202,7 @@ impl<'a> Batch<'a> {
                 .map_init(
                     || PairQuery::new(self.a, self.b),
                     |pair, i| match pair {
-                        Ok(pair) => {
-                            query(pair, &pose(&self.poses_a, i), &pose(&self.poses_b, i))
-                        }
+                        Ok(pair) => query(pair, &pose(&self.poses_a, i), &pose(&self.poses_b, i)),
                         Err(e) => Err(e.clone()),
                     },
                 )
@@ -1527,8 +1533,14 @@ mod tests {
     fn status_names_match_the_enum() {
         for (status, name) in [
             (ObbtreeStatus::Ok, "OBBTREE_STATUS_OK"),
-            (ObbtreeStatus::BufferTooSmall, "OBBTREE_STATUS_BUFFER_TOO_SMALL"),
-            (ObbtreeStatus::InternalError, "OBBTREE_STATUS_INTERNAL_ERROR"),
+            (
+                ObbtreeStatus::BufferTooSmall,
+                "OBBTREE_STATUS_BUFFER_TOO_SMALL",
+            ),
+            (
+                ObbtreeStatus::InternalError,
+                "OBBTREE_STATUS_INTERNAL_ERROR",
+            ),
         ] {
             // SAFETY: a static NUL-terminated string.
             let got = unsafe { CStr::from_ptr(obbtree_status_name(status as i32)) };

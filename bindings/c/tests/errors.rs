@@ -56,14 +56,22 @@ struct Cow {
 impl Cow {
     fn new(name: &str) -> Cow {
         let dir = common::scratch(name);
-        let tree = open(&common::build_cow(&dir, "cow.obbt", &BuildOptions::default()));
+        let tree = open(&common::build_cow(
+            &dir,
+            "cow.obbt",
+            &BuildOptions::default(),
+        ));
         let mut pair = null_mut();
         // SAFETY: an open tree and a writable pointer.
         ok(unsafe { obbtree_pair_new(tree, tree, &mut pair) });
         Cow { tree, pair, dir }
     }
 
-    fn collide(&self, pose_b: &[f64; 12], buffer: &mut [ObbtreeTrianglePair]) -> (ObbtreeStatus, ObbtreeCollideResult) {
+    fn collide(
+        &self,
+        pose_b: &[f64; 12],
+        buffer: &mut [ObbtreeTrianglePair],
+    ) -> (ObbtreeStatus, ObbtreeCollideResult) {
         let mut out = ObbtreeCollideResult::default();
         // SAFETY: live handle, 12 doubles each, `buffer.len()` writable pairs, a result.
         let status = unsafe {
@@ -72,7 +80,11 @@ impl Cow {
                 IDENTITY.as_ptr(),
                 pose_b.as_ptr(),
                 false,
-                if buffer.is_empty() { null_mut() } else { buffer.as_mut_ptr() },
+                if buffer.is_empty() {
+                    null_mut()
+                } else {
+                    buffer.as_mut_ptr()
+                },
                 buffer.len(),
                 &mut out,
             )
@@ -96,7 +108,7 @@ impl Drop for Cow {
 fn open_errors_have_codes_and_messages() {
     let dir = common::scratch("open-errors");
     let missing = CString::new(dir.join("missing.obbt").to_str().unwrap()).unwrap();
-    let mut tree = 1usize as *mut ObbtreeTree;
+    let mut tree = std::ptr::dangling_mut::<ObbtreeTree>();
     // SAFETY: a C string and a writable pointer.
     let status = unsafe { obbtree_open(missing.as_ptr(), &mut tree) };
     fails(status, ObbtreeStatus::Io, "missing.obbt");
@@ -123,16 +135,32 @@ fn open_errors_have_codes_and_messages() {
 
     // SAFETY: NULL arguments are what is tested.
     unsafe {
-        fails(obbtree_open(null(), &mut tree), ObbtreeStatus::NullPointer, "path is NULL");
-        fails(obbtree_open(junk.as_ptr(), null_mut()), ObbtreeStatus::NullPointer, "out is NULL");
+        fails(
+            obbtree_open(null(), &mut tree),
+            ObbtreeStatus::NullPointer,
+            "path is NULL",
+        );
+        fails(
+            obbtree_open(junk.as_ptr(), null_mut()),
+            ObbtreeStatus::NullPointer,
+            "out is NULL",
+        );
         fails(
             obbtree_open_bytes(null(), 10, &mut tree),
             ObbtreeStatus::NullPointer,
             "data is NULL",
         );
-        fails(obbtree_verify(null()), ObbtreeStatus::NullPointer, "tree is NULL");
+        fails(
+            obbtree_verify(null()),
+            ObbtreeStatus::NullPointer,
+            "tree is NULL",
+        );
         let mut info = std::mem::MaybeUninit::<ObbtreeInfo>::uninit();
-        fails(obbtree_info(null(), info.as_mut_ptr()), ObbtreeStatus::NullPointer, "tree is NULL");
+        fails(
+            obbtree_info(null(), info.as_mut_ptr()),
+            ObbtreeStatus::NullPointer,
+            "tree is NULL",
+        );
         // Closing and freeing NULL do nothing.
         obbtree_close(null_mut());
         obbtree_pair_free(null_mut());
@@ -177,7 +205,15 @@ fn bad_poses_and_options_are_refused() {
     let distance = |pose_b: &[f64; 12], rel: f64, max: f64, out: *mut ObbtreeDistanceResult| {
         // SAFETY: live handle, 12 doubles each, a writable result.
         unsafe {
-            obbtree_pair_distance(cow.pair, IDENTITY.as_ptr(), pose_b.as_ptr(), rel, 0.0, max, out)
+            obbtree_pair_distance(
+                cow.pair,
+                IDENTITY.as_ptr(),
+                pose_b.as_ptr(),
+                rel,
+                0.0,
+                max,
+                out,
+            )
         }
     };
     let mut scaled = translation(2.0, 0.0, 0.0);
@@ -220,7 +256,10 @@ fn bad_poses_and_options_are_refused() {
     ok(distance(&apart, 0.0, f64::INFINITY, out.as_mut_ptr()));
     // SAFETY: written by the successful call.
     let d = unsafe { out.assume_init() };
-    assert!(d.found && d.closest.distance > 0.5 && d.closest.distance < 2.0, "{d:?}");
+    assert!(
+        d.found && d.closest.distance > 0.5 && d.closest.distance < 2.0,
+        "{d:?}"
+    );
     ok(distance(&apart, 0.0, 0.01, out.as_mut_ptr()));
     // SAFETY: as above.
     let far = unsafe { out.assume_init() };
@@ -231,7 +270,13 @@ fn bad_poses_and_options_are_refused() {
     // SAFETY: live handle, poses, a writable result / NULL where tested.
     unsafe {
         fails(
-            obbtree_pair_within(cow.pair, IDENTITY.as_ptr(), apart.as_ptr(), -0.5, t.as_mut_ptr()),
+            obbtree_pair_within(
+                cow.pair,
+                IDENTITY.as_ptr(),
+                apart.as_ptr(),
+                -0.5,
+                t.as_mut_ptr(),
+            ),
             ObbtreeStatus::BadArgument,
             "tolerance",
         );
@@ -242,7 +287,12 @@ fn bad_poses_and_options_are_refused() {
         );
         let mut s = std::mem::MaybeUninit::<ObbtreeSpanResult>::uninit();
         fails(
-            obbtree_pair_span(null_mut(), IDENTITY.as_ptr(), apart.as_ptr(), s.as_mut_ptr()),
+            obbtree_pair_span(
+                null_mut(),
+                IDENTITY.as_ptr(),
+                apart.as_ptr(),
+                s.as_mut_ptr(),
+            ),
             ObbtreeStatus::NullPointer,
             "pair is NULL",
         );
@@ -259,15 +309,32 @@ fn bad_poses_and_options_are_refused() {
     // Checking and repairing poses.
     let mut rounded = [0.0; 12];
     let angle: f64 = 0.3;
-    let r = [angle.cos(), -angle.sin(), 0.0, angle.sin(), angle.cos(), 0.0, 0.0, 0.0, 1.0];
+    let r = [
+        angle.cos(),
+        -angle.sin(),
+        0.0,
+        angle.sin(),
+        angle.cos(),
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+    ];
     for (k, v) in r.iter().enumerate() {
         rounded[k] = (v * 1000.0).round() / 1000.0;
     }
     let mut repaired = [0.0; 12];
     // SAFETY: 12 doubles each.
     unsafe {
-        fails(obbtree_pose_check(rounded.as_ptr()), ObbtreeStatus::Pose, "not orthonormal");
-        ok(obbtree_pose_orthonormalize(rounded.as_ptr(), repaired.as_mut_ptr()));
+        fails(
+            obbtree_pose_check(rounded.as_ptr()),
+            ObbtreeStatus::Pose,
+            "not orthonormal",
+        );
+        ok(obbtree_pose_orthonormalize(
+            rounded.as_ptr(),
+            repaired.as_mut_ptr(),
+        ));
         ok(obbtree_pose_check(repaired.as_ptr()));
         fails(
             obbtree_pose_orthonormalize(scaled.as_ptr(), repaired.as_mut_ptr()),
@@ -284,7 +351,10 @@ fn a_short_buffer_reports_the_size_needed() {
     let (status, counted) = cow.collide(&touching, &mut []);
     ok(status);
     let needed = counted.pair_count;
-    assert!(needed > 3, "the cow touches itself in many places: {needed}");
+    assert!(
+        needed > 3,
+        "the cow touches itself in many places: {needed}"
+    );
     let mut full = vec![ObbtreeTrianglePair::default(); needed];
     let (status, all) = cow.collide(&touching, &mut full);
     ok(status);
@@ -303,12 +373,24 @@ fn a_short_buffer_reports_the_size_needed() {
     let mut out = ObbtreeCollideResult::default();
     // SAFETY: live handle, poses, a result; the NULL buffer is what is tested.
     let status = unsafe {
-        obbtree_pair_collide(cow.pair, IDENTITY.as_ptr(), touching.as_ptr(), false, null_mut(), 5, &mut out)
+        obbtree_pair_collide(
+            cow.pair,
+            IDENTITY.as_ptr(),
+            touching.as_ptr(),
+            false,
+            null_mut(),
+            5,
+            &mut out,
+        )
     };
     fails(status, ObbtreeStatus::NullPointer, "pairs is NULL");
 
     // Batches: the total needed, every result complete.
-    let poses = [translation(0.3, 0.0, 0.0), translation(2.0, 0.0, 0.0), translation(0.1, 0.0, 0.0)];
+    let poses = [
+        translation(0.3, 0.0, 0.0),
+        translation(2.0, 0.0, 0.0),
+        translation(0.1, 0.0, 0.0),
+    ];
     let mut results = [ObbtreeCollideResult::default(); 3];
     let mut buffer = vec![ObbtreeTrianglePair::default(); needed];
     let mut total = 0usize;
@@ -341,7 +423,9 @@ fn a_short_buffer_reports_the_size_needed() {
 #[test]
 fn batch_arguments_are_checked_and_batches_equal_single_calls() {
     let cow = Cow::new("batch");
-    let poses: Vec<[f64; 12]> = (0..8).map(|k| translation(0.25 * k as f64, 0.1, 0.0)).collect();
+    let poses: Vec<[f64; 12]> = (0..8)
+        .map(|k| translation(0.25 * k as f64, 0.1, 0.0))
+        .collect();
     let mut results = vec![
         ObbtreeDistanceResult {
             found: false,
@@ -356,7 +440,12 @@ fn batch_arguments_are_checked_and_batches_equal_single_calls() {
         };
         8
     ];
-    let batch = |count_a: usize, poses_b: &[[f64; 12]], count_b: usize, threads: usize, results: &mut [ObbtreeDistanceResult], len: usize| {
+    let batch = |count_a: usize,
+                 poses_b: &[[f64; 12]],
+                 count_b: usize,
+                 threads: usize,
+                 results: &mut [ObbtreeDistanceResult],
+                 len: usize| {
         let repeated: Vec<[f64; 12]> = vec![IDENTITY; count_a.max(1)];
         // SAFETY: open trees, `count` poses each (the slices hold at least that many),
         // `len` results (at most results.len(), as the callers pass).
@@ -377,26 +466,71 @@ fn batch_arguments_are_checked_and_batches_equal_single_calls() {
             )
         }
     };
-    fails(batch(3, &poses, 8, 0, &mut results, 8), ObbtreeStatus::BadArgument, "count_a is 3 and count_b is 8");
-    fails(batch(1, &poses, 8, 0, &mut results, 7), ObbtreeStatus::BadArgument, "results_len is 7");
+    fails(
+        batch(3, &poses, 8, 0, &mut results, 8),
+        ObbtreeStatus::BadArgument,
+        "count_a is 3 and count_b is 8",
+    );
+    fails(
+        batch(1, &poses, 8, 0, &mut results, 7),
+        ObbtreeStatus::BadArgument,
+        "results_len is 7",
+    );
     let mut bad = poses.clone();
     bad[5][4] = 3.0;
-    fails(batch(1, &bad, 8, 0, &mut results, 8), ObbtreeStatus::Pose, "poses_b[5]: rotation is not orthonormal");
+    fails(
+        batch(1, &bad, 8, 0, &mut results, 8),
+        ObbtreeStatus::Pose,
+        "poses_b[5]: rotation is not orthonormal",
+    );
     // SAFETY: NULL trees and poses are what is tested.
     unsafe {
         fails(
-            obbtree_span_batch(cow.tree, IDENTITY.as_ptr(), 1, cow.tree, IDENTITY.as_ptr(), 1, 0, null_mut(), 0),
+            obbtree_span_batch(
+                cow.tree,
+                IDENTITY.as_ptr(),
+                1,
+                cow.tree,
+                IDENTITY.as_ptr(),
+                1,
+                0,
+                null_mut(),
+                0,
+            ),
             ObbtreeStatus::BadArgument,
             "results_len is 0",
         );
-        let mut span = [ObbtreeSpanResult { farthest: results[0].closest, work: ObbtreeWork::default() }; 1];
+        let mut span = [ObbtreeSpanResult {
+            farthest: results[0].closest,
+            work: ObbtreeWork::default(),
+        }; 1];
         fails(
-            obbtree_span_batch(null(), IDENTITY.as_ptr(), 1, cow.tree, IDENTITY.as_ptr(), 1, 0, span.as_mut_ptr(), 1),
+            obbtree_span_batch(
+                null(),
+                IDENTITY.as_ptr(),
+                1,
+                cow.tree,
+                IDENTITY.as_ptr(),
+                1,
+                0,
+                span.as_mut_ptr(),
+                1,
+            ),
             ObbtreeStatus::NullPointer,
             "a is NULL",
         );
         fails(
-            obbtree_span_batch(cow.tree, null(), 1, cow.tree, IDENTITY.as_ptr(), 1, 0, span.as_mut_ptr(), 1),
+            obbtree_span_batch(
+                cow.tree,
+                null(),
+                1,
+                cow.tree,
+                IDENTITY.as_ptr(),
+                1,
+                0,
+                span.as_mut_ptr(),
+                1,
+            ),
             ObbtreeStatus::NullPointer,
             "poses_a is NULL",
         );
@@ -408,7 +542,15 @@ fn batch_arguments_are_checked_and_batches_equal_single_calls() {
             let mut single = std::mem::MaybeUninit::<ObbtreeDistanceResult>::uninit();
             // SAFETY: live handle, poses, a result.
             ok(unsafe {
-                obbtree_pair_distance(cow.pair, IDENTITY.as_ptr(), pose.as_ptr(), 0.0, 0.0, f64::INFINITY, single.as_mut_ptr())
+                obbtree_pair_distance(
+                    cow.pair,
+                    IDENTITY.as_ptr(),
+                    pose.as_ptr(),
+                    0.0,
+                    0.0,
+                    f64::INFINITY,
+                    single.as_mut_ptr(),
+                )
             });
             // SAFETY: written by the successful call.
             assert_eq!(unsafe { single.assume_init() }, *batched);
@@ -423,13 +565,17 @@ fn batch_arguments_are_checked_and_batches_equal_single_calls() {
 #[test]
 fn mismatched_trees_are_refused() {
     let dir = common::scratch("mismatched");
-    let obb = open(&common::build_cow(&dir, "obb.obbt", &BuildOptions::default()));
+    let obb = open(&common::build_cow(
+        &dir,
+        "obb.obbt",
+        &BuildOptions::default(),
+    ));
     let aabb_options = BuildOptions {
         bv: BvKind::Aabb,
         ..BuildOptions::default()
     };
     let aabb = open(&common::build_cow(&dir, "aabb.obbt", &aabb_options));
-    let mut pair = 1usize as *mut ObbtreePair;
+    let mut pair = std::ptr::dangling_mut::<ObbtreePair>();
     let mut result = [ObbtreeCollideResult::default()];
     // SAFETY: open trees, writable outputs, 1 pose each.
     unsafe {
@@ -440,7 +586,21 @@ fn mismatched_trees_are_refused() {
         );
         assert!(pair.is_null());
         fails(
-            obbtree_collide_batch(obb, IDENTITY.as_ptr(), 1, aabb, IDENTITY.as_ptr(), 1, true, 0, result.as_mut_ptr(), 1, null_mut(), 0, null_mut()),
+            obbtree_collide_batch(
+                obb,
+                IDENTITY.as_ptr(),
+                1,
+                aabb,
+                IDENTITY.as_ptr(),
+                1,
+                true,
+                0,
+                result.as_mut_ptr(),
+                1,
+                null_mut(),
+                0,
+                null_mut(),
+            ),
             ObbtreeStatus::MismatchedTrees,
             "differ in kind",
         );
@@ -453,7 +613,9 @@ fn mismatched_trees_are_refused() {
 #[test]
 fn threads_share_a_tree_and_a_pair_outlives_its_closed_tree() {
     let cow = Cow::new("threads");
-    let poses: Vec<[f64; 12]> = (0..16).map(|k| translation(0.1 * k as f64, 0.05, 0.0)).collect();
+    let poses: Vec<[f64; 12]> = (0..16)
+        .map(|k| translation(0.1 * k as f64, 0.05, 0.0))
+        .collect();
     let span = |pair: *mut ObbtreePair, pose: &[f64; 12]| {
         let mut out = std::mem::MaybeUninit::<ObbtreeSpanResult>::uninit();
         // SAFETY: a live handle used by this thread only, poses, a result.
@@ -487,7 +649,11 @@ fn threads_share_a_tree_and_a_pair_outlives_its_closed_tree() {
 
     // A pair keeps its trees mapped after they are closed.
     let dir = common::scratch("outlives");
-    let tree = open(&common::build_cow(&dir, "cow.obbt", &BuildOptions::default()));
+    let tree = open(&common::build_cow(
+        &dir,
+        "cow.obbt",
+        &BuildOptions::default(),
+    ));
     let mut pair = null_mut();
     // SAFETY: an open tree, then closed while the handle lives; the handle freed once.
     unsafe {

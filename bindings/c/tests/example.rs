@@ -8,8 +8,7 @@ mod common;
 use obbtree::build::BuildOptions;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    CollideOptions, DistanceOptions, PairQuery, Pose, SpanOptions, ToleranceOptions, Witness,
-    Work,
+    CollideOptions, DistanceOptions, PairQuery, Pose, SpanOptions, ToleranceOptions, Witness, Work,
 };
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -120,7 +119,10 @@ fn bool_value(b: bool) -> Value {
 }
 
 fn pose_of(answers: &Answers, query: &str, index: usize) -> Pose {
-    match answers.get(&(query.to_string(), index)).and_then(|l| l.get("p")) {
+    match answers
+        .get(&(query.to_string(), index))
+        .and_then(|l| l.get("p"))
+    {
         Some(Value::Numbers(p)) => Pose::from_row_major(p).expect("the example's pose is rigid"),
         other => panic!("no pose {query} {index}: {other:?}"),
     }
@@ -276,7 +278,9 @@ fn library_dir() -> PathBuf {
 }
 
 fn run(command: &mut Command) -> String {
-    let output = command.output().unwrap_or_else(|e| panic!("{command:?}: {e}"));
+    let output = command
+        .output()
+        .unwrap_or_else(|e| panic!("{command:?}: {e}"));
     assert!(
         output.status.success(),
         "{command:?} failed ({}):\n{}\n{}",
@@ -326,14 +330,20 @@ fn the_c_example_answers_as_the_rust_api() {
     for (key, want) in &expected {
         assert_eq!(printed.get(key), Some(want), "line {key:?} of:\n{output}");
     }
-    let extra: Vec<_> = printed.keys().filter(|k| !expected.contains_key(k)).collect();
+    let extra: Vec<_> = printed
+        .keys()
+        .filter(|k| !expected.contains_key(k))
+        .collect();
     assert!(extra.is_empty(), "lines the test does not check: {extra:?}");
 
     // The example covers what it claims: collisions and separations among its poses.
     let colliding: Vec<bool> = (0..4)
         .map(|i| printed[&("collide".to_string(), i)]["colliding"] == num(1))
         .collect();
-    assert!(colliding.contains(&true) && colliding.contains(&false), "{colliding:?}");
+    assert!(
+        colliding.contains(&true) && colliding.contains(&false),
+        "{colliding:?}"
+    );
     let error = output
         .lines()
         .find(|l| l.starts_with("error "))

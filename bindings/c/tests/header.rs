@@ -7,8 +7,8 @@ use std::path::Path;
 #[test]
 fn the_committed_header_is_current() {
     let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let config = cbindgen::Config::from_file(crate_dir.join("cbindgen.toml"))
-        .expect("cbindgen.toml reads");
+    let config =
+        cbindgen::Config::from_file(crate_dir.join("cbindgen.toml")).expect("cbindgen.toml reads");
     let mut generated = Vec::new();
     cbindgen::Builder::new()
         .with_crate(crate_dir)
@@ -32,7 +32,10 @@ fn the_committed_header_is_current() {
     for line in source.lines() {
         if let Some(rest) = line.split("extern \"C\" fn ").nth(1) {
             let name = rest.split('(').next().unwrap_or_default();
-            assert!(generated.contains(&format!("{name}(")), "{name} missing from the header");
+            assert!(
+                generated.contains(&format!("{name}(")),
+                "{name} missing from the header"
+            );
         }
     }
 }
