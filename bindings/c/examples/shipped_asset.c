@@ -145,6 +145,7 @@ int main(int argc, char **argv) {
     }
 
     /* One pose pair per call through a pair handle (one per thread). */
+    const double rel_err = 0.1, max_distance = 0.5, tolerance = 0.05;
     ObbtreePair *pair = NULL;
     check(obbtree_pair_new(mapped, embedded, &pair), "obbtree_pair_new");
     for (int i = 0; i < POSES; i++) {
@@ -176,19 +177,21 @@ int main(int argc, char **argv) {
         print_witness(&d.closest, d.found);
         print_work(&d.work);
         printf("\n");
-        check(obbtree_pair_distance(pair, pose_a, pose_b, 0.1, 0.0, INFINITY, &d), "distance");
-        printf("distance_rel %d found=%d", i, (int)d.found);
+        check(obbtree_pair_distance(pair, pose_a, pose_b, rel_err, 0.0, INFINITY, &d),
+              "distance");
+        printf("distance_rel %d rel_err=%.17g found=%d", i, rel_err, (int)d.found);
         print_witness(&d.closest, d.found);
         printf("\n");
-        check(obbtree_pair_distance(pair, pose_a, pose_b, 0.0, 0.0, 0.5, &d), "distance");
-        printf("distance_max %d found=%d", i, (int)d.found);
+        check(obbtree_pair_distance(pair, pose_a, pose_b, 0.0, 0.0, max_distance, &d),
+              "distance");
+        printf("distance_max %d max_distance=%.17g found=%d", i, max_distance, (int)d.found);
         print_witness(&d.closest, d.found);
         printf("\n");
 
         /* Tolerance: closer than 0.05? */
         ObbtreeToleranceResult t;
-        check(obbtree_pair_within(pair, pose_a, pose_b, 0.05, &t), "within");
-        printf("within %d closer=%d", i, (int)t.closer);
+        check(obbtree_pair_within(pair, pose_a, pose_b, tolerance, &t), "within");
+        printf("within %d tolerance=%.17g closer=%d", i, tolerance, (int)t.closer);
         print_witness(&t.witness, t.closer);
         printf("\n");
 
@@ -224,7 +227,7 @@ int main(int argc, char **argv) {
                                  INFINITY, 2, distances, POSES),
           "distance batch");
     ObbtreeToleranceResult tolerances[POSES];
-    check(obbtree_within_batch(mapped, pose_a, 1, embedded, &poses_b[0][0], POSES, 0.05, 2,
+    check(obbtree_within_batch(mapped, pose_a, 1, embedded, &poses_b[0][0], POSES, tolerance, 2,
                                tolerances, POSES),
           "within batch");
     ObbtreeSpanResult spans[POSES];
@@ -234,7 +237,8 @@ int main(int argc, char **argv) {
     for (int i = 0; i < POSES; i++) {
         printf("batch_distance %d found=%d", i, (int)distances[i].found);
         print_witness(&distances[i].closest, distances[i].found);
-        printf("\nbatch_within %d closer=%d", i, (int)tolerances[i].closer);
+        printf("\nbatch_within %d tolerance=%.17g closer=%d", i, tolerance,
+               (int)tolerances[i].closer);
         print_witness(&tolerances[i].witness, tolerances[i].closer);
         printf("\nbatch_span %d", i);
         print_witness(&spans[i].farthest, true);

@@ -229,13 +229,19 @@ fn expected(tree: &Path, printed: &Answers) -> Answers {
             values.push(("pair", pairs_value(&[*p])));
         }
         e.line("first", i, &values);
-        for (query, options) in [
-            ("distance", &exact),
-            ("distance_rel", &rel),
-            ("distance_max", &max),
+        for (query, options, option) in [
+            ("distance", &exact, None),
+            ("distance_rel", &rel, Some(("rel_err", rel.rel_err))),
+            (
+                "distance_max",
+                &max,
+                Some(("max_distance", max.max_distance)),
+            ),
         ] {
             let d = pair.distance(&pose_a, &pose_b, options).expect("distance");
-            let mut values = vec![("found", bool_value(d.closest.is_some()))];
+            // The option as the example printed it, so that a change there shows here.
+            let mut values: Vec<_> = option.map(|(k, v)| (k, num(v))).into_iter().collect();
+            values.push(("found", bool_value(d.closest.is_some())));
             values.extend(witness(d.distance(), d.closest.as_ref()));
             if query == "distance" {
                 e.line("batch_distance", i, &values);
@@ -244,7 +250,10 @@ fn expected(tree: &Path, printed: &Answers) -> Answers {
             e.line(query, i, &values);
         }
         let t = pair.within(&pose_a, &pose_b, &tolerance).expect("within");
-        let mut values = vec![("closer", bool_value(t.closer()))];
+        let mut values = vec![
+            ("tolerance", num(tolerance.tolerance)),
+            ("closer", bool_value(t.closer())),
+        ];
         let d = t.witness.map_or(f64::INFINITY, |w| w.distance);
         values.extend(witness(d, t.witness.as_ref()));
         e.line("within", i, &values);
