@@ -7,195 +7,347 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// Triangle id of a result without a triangle (a distance beyond `max_distance`, a
-// tolerance query with no pair closer than the tolerance).
+/**
+ * Triangle id of a result without a triangle (a distance beyond `max_distance`, a
+ * tolerance query with no pair closer than the tolerance).
+ */
 #define OBBTREE_NO_TRIANGLE UINT32_MAX
 
-// What a call did: `OBBTREE_STATUS_OK`, or why it failed (then [`obbtree_last_error`] says
-// more).
+/**
+ * What a call did: `OBBTREE_STATUS_OK`, or why it failed (then `obbtree_last_error` says
+ * more).
+ */
 typedef enum ObbtreeStatus {
-  // Success.
+  /**
+   * Success.
+   */
   OBBTREE_STATUS_OK = 0,
-  // A required pointer argument is NULL.
+  /**
+   * A required pointer argument is NULL.
+   */
   OBBTREE_STATUS_NULL_POINTER = 1,
-  // An argument is out of range: a count, a misaligned pointer, a negative or
-  // non-finite option, batch sizes that do not match, a path that is not valid text.
+  /**
+   * An argument is out of range: a count, a misaligned pointer, a negative or
+   * non-finite option, batch sizes that do not match, a path that is not valid text.
+   */
   OBBTREE_STATUS_BAD_ARGUMENT = 2,
-  // The operating system refused to open or map the file.
+  /**
+   * The operating system refused to open or map the file.
+   */
   OBBTREE_STATUS_IO = 3,
-  // The bytes are not a valid `.obbt` header and section directory.
+  /**
+   * The bytes are not a valid `.obbt` header and section directory.
+   */
   OBBTREE_STATUS_FORMAT = 4,
-  // `obbtree_verify` found damage in the sections.
+  /**
+   * `obbtree_verify` found damage in the sections.
+   */
   OBBTREE_STATUS_VERIFY = 5,
-  // A pose is not a rigid motion (not finite, not orthonormal, a reflection).
+  /**
+   * A pose is not a rigid motion (not finite, not orthonormal, a reflection).
+   */
   OBBTREE_STATUS_POSE = 6,
-  // The two trees store different volume types or precisions.
+  /**
+   * The two trees store different volume types or precisions.
+   */
   OBBTREE_STATUS_MISMATCHED_TREES = 7,
-  // A tree's nodes are inconsistent (a damaged file that was not verified).
+  /**
+   * A tree's nodes are inconsistent (a damaged file that was not verified).
+   */
   OBBTREE_STATUS_CORRUPT_TREE = 8,
-  // The caller's pair buffer is too short: the results are complete, the buffer holds
-  // the first `capacity` pairs, and the number needed is reported.
+  /**
+   * The caller's pair buffer is too short: the results are complete, the buffer holds
+   * the first `capacity` pairs, and the number needed is reported.
+   */
   OBBTREE_STATUS_BUFFER_TOO_SMALL = 9,
-  // Another thread is using this pair handle right now.
+  /**
+   * Another thread is using this pair handle right now.
+   */
   OBBTREE_STATUS_BUSY = 10,
-  // A bug in obbtree (a Rust panic, caught at the boundary); the message says where.
+  /**
+   * A bug in obbtree (a Rust panic, caught at the boundary); the message says where.
+   */
   OBBTREE_STATUS_INTERNAL_ERROR = 11,
 } ObbtreeStatus;
 
-// The bounding volume type a tree stores (the values are the file's header tags).
+/**
+ * The bounding volume type a tree stores (the values are the file's header tags).
+ */
 typedef enum ObbtreeVolume {
-  // Oriented bounding boxes.
+  /**
+   * Oriented bounding boxes.
+   */
   OBBTREE_VOLUME_OBB = 1,
-  // Axis-aligned bounding boxes (in the model frame).
+  /**
+   * Axis-aligned bounding boxes (in the model frame).
+   */
   OBBTREE_VOLUME_AABB = 2,
-  // Bounding spheres.
+  /**
+   * Bounding spheres.
+   */
   OBBTREE_VOLUME_SPHERE = 3,
 } ObbtreeVolume;
 
-// The precision a tree stores its numbers in (the values are bytes per number).
+/**
+ * The precision a tree stores its numbers in (the values are bytes per number).
+ */
 typedef enum ObbtreePrecision {
-  // 32-bit floats.
+  /**
+   * 32-bit floats.
+   */
   OBBTREE_PRECISION_F32 = 4,
-  // 64-bit floats.
+  /**
+   * 64-bit floats.
+   */
   OBBTREE_PRECISION_F64 = 8,
 } ObbtreePrecision;
 
-// Two trees checked to be queryable together, with the traversal scratch kept between
-// queries (opaque). Made by [`obbtree_pair_new`], released by [`obbtree_pair_free`]. One
-// thread at a time: a handle may move between threads, but a call made while another
-// thread is inside a call on the same handle returns `OBBTREE_STATUS_BUSY`. Give each
-// thread its own handle.
+/**
+ * Two trees checked to be queryable together, with the traversal scratch kept between
+ * queries (opaque). Made by `obbtree_pair_new`, released by `obbtree_pair_free`. One
+ * thread at a time: a handle may move between threads, but a call made while another
+ * thread is inside a call on the same handle returns `OBBTREE_STATUS_BUSY`. Give each
+ * thread its own handle.
+ */
 typedef struct ObbtreePair ObbtreePair;
 
-// An open `.obbt` tree (opaque). Made by [`obbtree_open`] or [`obbtree_open_bytes`],
-// released by [`obbtree_close`]. Read-only: any number of threads may query one tree at
-// once.
+/**
+ * An open `.obbt` tree (opaque). Made by `obbtree_open` or `obbtree_open_bytes`,
+ * released by `obbtree_close`. Read-only: any number of threads may query one tree at
+ * once.
+ */
 typedef struct ObbtreeTree ObbtreeTree;
 
-// What a tree's header says (`obbtree info`), read without touching the sections.
+/**
+ * What a tree's header says (`obbtree info`), read without touching the sections.
+ */
 typedef struct ObbtreeInfo {
-  // Format version, major part.
+  /**
+   * Format version, major part.
+   */
   uint16_t version_major;
-  // Format version, minor part.
+  /**
+   * Format version, minor part.
+   */
   uint16_t version_minor;
-  // Bounding volume type.
+  /**
+   * Bounding volume type.
+   */
   enum ObbtreeVolume volume;
-  // Stored precision.
+  /**
+   * Stored precision.
+   */
   enum ObbtreePrecision precision;
-  // `"obb"`, `"aabb"` or `"sphere"` (static string).
+  /**
+   * `"obb"`, `"aabb"` or `"sphere"` (static string).
+   */
   const char *volume_name;
-  // `"f32"` or `"f64"` (static string).
+  /**
+   * `"f32"` or `"f64"` (static string).
+   */
   const char *precision_name;
-  // How the volumes were fitted: `"hull"`, `"triangles"` or `"vertices"` (static string).
+  /**
+   * How the volumes were fitted: `"hull"`, `"triangles"` or `"vertices"` (static string).
+   */
   const char *fit_name;
-  // Node encoding: `"binary"` or `"variable"` (static string).
+  /**
+   * Node encoding: `"binary"` or `"variable"` (static string).
+   */
   const char *encoding_name;
-  // Triangle count.
+  /**
+   * Triangle count.
+   */
   uint32_t triangles;
-  // Vertex count.
+  /**
+   * Vertex count.
+   */
   uint32_t vertices;
-  // Node count.
+  /**
+   * Node count.
+   */
   uint32_t nodes;
-  // Leaf count.
+  /**
+   * Leaf count.
+   */
   uint32_t leaves;
-  // Depth of the tree (a root alone has depth 0).
+  /**
+   * Depth of the tree (a root alone has depth 0).
+   */
   uint32_t depth;
-  // Most faces in one leaf.
+  /**
+   * Most faces in one leaf.
+   */
   uint32_t max_leaf_faces;
-  // The leaf size the tree was built with.
+  /**
+   * The leaf size the tree was built with.
+   */
   uint32_t leaf_size;
-  // Triangles of zero area.
+  /**
+   * Triangles of zero area.
+   */
   uint32_t degenerate_triangles;
-  // Smallest corner of the vertices' bounding box, in stored units (see `placement_*`).
+  /**
+   * Smallest corner of the vertices' bounding box, in stored units (see `placement_*`).
+   */
   double bounds_min[3];
-  // Largest corner of the vertices' bounding box, in stored units.
+  /**
+   * Largest corner of the vertices' bounding box, in stored units.
+   */
   double bounds_max[3];
-  // Stored units per input unit: `stored = placement_scale * input + placement_offset`.
+  /**
+   * Stored units per input unit: `stored = placement_scale * input + placement_offset`.
+   */
   double placement_scale;
-  // Added after scaling, stored units.
+  /**
+   * Added after scaling, stored units.
+   */
   double placement_offset[3];
-  // File length in bytes.
+  /**
+   * File length in bytes.
+   */
   uint64_t file_bytes;
 } ObbtreeInfo;
 
-// A contacting triangle pair: input-mesh triangle ids of A and of B.
+/**
+ * A contacting triangle pair: input-mesh triangle ids of A and of B.
+ */
 typedef struct ObbtreeTrianglePair {
-  // Triangle of A.
+  /**
+   * Triangle of A.
+   */
   uint32_t tri_a;
-  // Triangle of B.
+  /**
+   * Triangle of B.
+   */
   uint32_t tri_b;
 } ObbtreeTrianglePair;
 
-// Work a query did (the dissertation's counts, §2.5.1).
+/**
+ * Work a query did (the dissertation's counts, §2.5.1).
+ */
 typedef struct ObbtreeWork {
-  // Bounding-volume pair tests that pruned the pair.
+  /**
+   * Bounding-volume pair tests that pruned the pair.
+   */
   uint64_t bv_disjoint;
-  // Bounding-volume pair tests that did not prune.
+  /**
+   * Bounding-volume pair tests that did not prune.
+   */
   uint64_t bv_overlap;
-  // Triangle pair tests whose triangles do not touch.
+  /**
+   * Triangle pair tests whose triangles do not touch.
+   */
   uint64_t tri_separated;
-  // Triangle pair tests whose triangles touch.
+  /**
+   * Triangle pair tests whose triangles touch.
+   */
   uint64_t tri_contact;
-  // Node pairs the traversal decided on.
+  /**
+   * Node pairs the traversal decided on.
+   */
   uint64_t nodes_visited;
 } ObbtreeWork;
 
-// The answer of a collision query.
+/**
+ * The answer of a collision query.
+ */
 typedef struct ObbtreeCollideResult {
-  // 1 when any triangle of A touches any triangle of B.
+  /**
+   * 1 when any triangle of A touches any triangle of B.
+   */
   bool colliding;
-  // Contacting triangle pairs (at most 1 with `first_contact`).
+  /**
+   * Contacting triangle pairs (at most 1 with `first_contact`).
+   */
   size_t pair_count;
-  // Where this answer's pairs start in the pairs buffer (0 for a single query; in a
-  // batch, the pairs of all poses follow each other in pose order).
+  /**
+   * Where this answer's pairs start in the pairs buffer (0 for a single query; in a
+   * batch, the pairs of all poses follow each other in pose order).
+   */
   size_t pair_offset;
-  // Work done.
+  /**
+   * Work done.
+   */
   struct ObbtreeWork work;
 } ObbtreeCollideResult;
 
-// A triangle of A and one of B with the distance between them and the points realising
-// it (world frame). Without a pair (see the result's flag) the distance is +infinity, the
-// points are NaN and the triangles are `OBBTREE_NO_TRIANGLE`.
+/**
+ * A triangle of A and one of B with the distance between them and the points realising
+ * it (world frame). Without a pair (see the result's flag) the distance is +infinity, the
+ * points are NaN and the triangles are `OBBTREE_NO_TRIANGLE`.
+ */
 typedef struct ObbtreeWitness {
-  // Distance between `point_a` and `point_b`, world units.
+  /**
+   * Distance between `point_a` and `point_b`, world units.
+   */
   double distance;
-  // The point on A, world frame.
+  /**
+   * The point on A, world frame.
+   */
   double point_a[3];
-  // The point on B, world frame.
+  /**
+   * The point on B, world frame.
+   */
   double point_b[3];
-  // Input-mesh id of A's triangle holding `point_a`.
+  /**
+   * Input-mesh id of A's triangle holding `point_a`.
+   */
   uint32_t tri_a;
-  // Input-mesh id of B's triangle holding `point_b`.
+  /**
+   * Input-mesh id of B's triangle holding `point_b`.
+   */
   uint32_t tri_b;
 } ObbtreeWitness;
 
-// The answer of a distance query.
+/**
+ * The answer of a distance query.
+ */
 typedef struct ObbtreeDistanceResult {
-  // 0 when the models are at least `max_distance` apart (then `closest.distance` is
-  // +infinity), 1 otherwise.
+  /**
+   * 0 when the models are at least `max_distance` apart (then `closest.distance` is
+   * +infinity), 1 otherwise.
+   */
   bool found;
-  // The closest pair (distance 0 when the surfaces touch).
+  /**
+   * The closest pair (distance 0 when the surfaces touch).
+   */
   struct ObbtreeWitness closest;
-  // Work done.
+  /**
+   * Work done.
+   */
   struct ObbtreeWork work;
 } ObbtreeDistanceResult;
 
-// The answer of a tolerance query.
+/**
+ * The answer of a tolerance query.
+ */
 typedef struct ObbtreeToleranceResult {
-  // 1 when the surfaces come closer than the tolerance.
+  /**
+   * 1 when the surfaces come closer than the tolerance.
+   */
   bool closer;
-  // With `closer`: a pair closer than the tolerance (not necessarily the closest).
+  /**
+   * With `closer`: a pair closer than the tolerance (not necessarily the closest).
+   */
   struct ObbtreeWitness witness;
-  // Work done.
+  /**
+   * Work done.
+   */
   struct ObbtreeWork work;
 } ObbtreeToleranceResult;
 
-// The answer of a span query.
+/**
+ * The answer of a span query.
+ */
 typedef struct ObbtreeSpanResult {
-  // The farthest pair: `farthest.distance` is the span, the largest distance between a
-  // point of A and a point of B.
+  /**
+   * The farthest pair: `farthest.distance` is the span, the largest distance between a
+   * point of A and a point of B.
+   */
   struct ObbtreeWitness farthest;
-  // Work done.
+  /**
+   * Work done.
+   */
   struct ObbtreeWork work;
 } ObbtreeSpanResult;
 
@@ -203,129 +355,155 @@ typedef struct ObbtreeSpanResult {
 extern "C" {
 #endif // __cplusplus
 
-// The version of this library, e.g. `"0.1.0"` (static string).
+/**
+ * The version of this library, e.g. `"0.1.0"` (static string).
+ */
 const char *obbtree_version(void);
 
-// The message of this thread's latest obbtree call: one line saying what failed, or `""`
-// when that call succeeded. Never NULL. The string belongs to the library and stays valid
-// until the next obbtree call on the same thread; copy it to keep it.
+/**
+ * The message of this thread's latest obbtree call: one line saying what failed, or `""`
+ * when that call succeeded. Never NULL. The string belongs to the library and stays valid
+ * until the next obbtree call on the same thread; copy it to keep it.
+ */
 const char *obbtree_last_error(void);
 
-// The name of a status code, e.g. `"OBBTREE_STATUS_POSE"` (static string; `"unknown"`
-// for a value that is not a status).
+/**
+ * The name of a status code, e.g. `"OBBTREE_STATUS_POSE"` (static string; `"unknown"`
+ * for a value that is not a status).
+ */
 const char *obbtree_status_name(int32_t status);
 
-// Opens the `.obbt` file at `path` (a NUL-terminated path in the system's encoding; UTF-8
-// on Windows): memory-maps it and checks its header and directory, in constant time for
-// any size. Does not check the sections: call [`obbtree_verify`] for a file from
-// elsewhere. On success `*out` is the tree, to be released with [`obbtree_close`]; on
-// failure `*out` is NULL (`OBBTREE_STATUS_IO`, `OBBTREE_STATUS_FORMAT`).
-//
-// Do not modify the file in place while it is open (replacing it by renaming another file
-// over it, as obbtree's own writer does, is fine).
-//
-// # Safety
-//
-// `path` is NULL or a NUL-terminated string; `out` is NULL or points at writable storage
-// for one pointer.
+/**
+ * Opens the `.obbt` file at `path` (a NUL-terminated path in the system's encoding; UTF-8
+ * on Windows): memory-maps it and checks its header and directory, in constant time for
+ * any size. Does not check the sections: call `obbtree_verify` for a file from
+ * elsewhere. On success `*out` is the tree, to be released with `obbtree_close`; on
+ * failure `*out` is NULL (`OBBTREE_STATUS_IO`, `OBBTREE_STATUS_FORMAT`).
+ *
+ * Do not modify the file in place while it is open (replacing it by renaming another file
+ * over it, as obbtree's own writer does, is fine).
+ *
+ * # Safety
+ *
+ * `path` is NULL or a NUL-terminated string; `out` is NULL or points at writable storage
+ * for one pointer.
+ */
 enum ObbtreeStatus obbtree_open(const char *path, struct ObbtreeTree **out);
 
-// Opens a tree from `len` bytes at `data`: a whole `.obbt` image in memory, for example an
-// asset embedded in the executable. The bytes are copied into a 64-byte aligned buffer
-// owned by the tree (the library views sections in place, which needs that alignment),
-// so `data` may have any alignment and may be freed as soon as this returns. The
-// header and directory are checked as by [`obbtree_open`]; on success `*out` is the tree,
-// to be released with [`obbtree_close`], on failure NULL (`OBBTREE_STATUS_FORMAT`).
-//
-// # Safety
-//
-// `data` is NULL or points at `len` readable bytes; `out` is NULL or points at writable
-// storage for one pointer.
+/**
+ * Opens a tree from `len` bytes at `data`: a whole `.obbt` image in memory, for example an
+ * asset embedded in the executable. The bytes are copied into a 64-byte aligned buffer
+ * owned by the tree (the library views sections in place, which needs that alignment),
+ * so `data` may have any alignment and may be freed as soon as this returns. The
+ * header and directory are checked as by `obbtree_open`; on success `*out` is the tree,
+ * to be released with `obbtree_close`, on failure NULL (`OBBTREE_STATUS_FORMAT`).
+ *
+ * # Safety
+ *
+ * `data` is NULL or points at `len` readable bytes; `out` is NULL or points at writable
+ * storage for one pointer.
+ */
 enum ObbtreeStatus obbtree_open_bytes(const uint8_t *data, size_t len, struct ObbtreeTree **out);
 
-// Releases a tree. Pair handles made from it stay valid (they keep what they need); the
-// file is unmapped when the last of them is freed. NULL is ignored.
-//
-// # Safety
-//
-// `tree` is NULL or a tree from [`obbtree_open`] / [`obbtree_open_bytes`] not yet closed;
-// no other thread is using it, and it is not used after this call.
+/**
+ * Releases a tree. Pair handles made from it stay valid (they keep what they need); the
+ * file is unmapped when the last of them is freed. NULL is ignored.
+ *
+ * # Safety
+ *
+ * `tree` is NULL or a tree from `obbtree_open` / `obbtree_open_bytes` not yet closed;
+ * no other thread is using it, and it is not used after this call.
+ */
 void obbtree_close(struct ObbtreeTree *tree);
 
-// Runs the O(n) checks of the format on `tree`: section checksums, padding, indices in
-// bounds, a well-formed tree, finite values, and every volume containing the vertices
-// below it. `OBBTREE_STATUS_VERIFY` with the first problem found when damaged. Run it once
-// on a file that came from elsewhere: queries on a damaged, unverified file give
-// `OBBTREE_STATUS_CORRUPT_TREE` or wrong answers, never undefined behaviour.
-//
-// # Safety
-//
-// `tree` is NULL or an open tree.
+/**
+ * Runs the O(n) checks of the format on `tree`: section checksums, padding, indices in
+ * bounds, a well-formed tree, finite values, and every volume containing the vertices
+ * below it. `OBBTREE_STATUS_VERIFY` with the first problem found when damaged. Run it once
+ * on a file that came from elsewhere: queries on a damaged, unverified file give
+ * `OBBTREE_STATUS_CORRUPT_TREE` or wrong answers, never undefined behaviour.
+ *
+ * # Safety
+ *
+ * `tree` is NULL or an open tree.
+ */
 enum ObbtreeStatus obbtree_verify(const struct ObbtreeTree *tree);
 
-// Fills `*out` with what the tree's header says (constant time).
-//
-// # Safety
-//
-// `tree` is NULL or an open tree; `out` is NULL or points at a writable `ObbtreeInfo`.
+/**
+ * Fills `*out` with what the tree's header says (constant time).
+ *
+ * # Safety
+ *
+ * `tree` is NULL or an open tree; `out` is NULL or points at a writable `ObbtreeInfo`.
+ */
 enum ObbtreeStatus obbtree_info(const struct ObbtreeTree *tree, struct ObbtreeInfo *out);
 
-// Checks that the 12 numbers at `pose` are a rigid motion as every query requires:
-// `OBBTREE_STATUS_OK`, or `OBBTREE_STATUS_POSE` saying what is wrong.
-//
-// # Safety
-//
-// `pose` is NULL or points at 12 readable doubles.
+/**
+ * Checks that the 12 numbers at `pose` are a rigid motion as every query requires:
+ * `OBBTREE_STATUS_OK`, or `OBBTREE_STATUS_POSE` saying what is wrong.
+ *
+ * # Safety
+ *
+ * `pose` is NULL or points at 12 readable doubles.
+ */
 enum ObbtreeStatus obbtree_pose_check(const double *pose);
 
-// Writes to `out` the rigid pose nearest to the 12 numbers at `pose` (the rotation
-// replaced by the nearest rotation, as the CLI's `--orthonormalize`): for rotations
-// printed with few decimals. Refuses (`OBBTREE_STATUS_POSE`) a change of any entry by more
-// than 1e-2 (a scaled or sheared matrix), reflections and non-finite numbers. `out` may be
-// `pose` itself.
-//
-// # Safety
-//
-// `pose` is NULL or points at 12 readable doubles; `out` is NULL or points at 12 writable
-// doubles.
+/**
+ * Writes to `out` the rigid pose nearest to the 12 numbers at `pose` (the rotation
+ * replaced by the nearest rotation, as the CLI's `--orthonormalize`): for rotations
+ * printed with few decimals. Refuses (`OBBTREE_STATUS_POSE`) a change of any entry by more
+ * than 1e-2 (a scaled or sheared matrix), reflections and non-finite numbers. `out` may be
+ * `pose` itself.
+ *
+ * # Safety
+ *
+ * `pose` is NULL or points at 12 readable doubles; `out` is NULL or points at 12 writable
+ * doubles.
+ */
 enum ObbtreeStatus obbtree_pose_orthonormalize(const double *pose, double *out);
 
-// Makes a pair handle for trees `a` and `b` (they may be the same tree): checks that they
-// store the same volume type and precision (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
-// and prepares the traversal once. `*out` is the handle, to be released with
-// [`obbtree_pair_free`]; NULL on failure. The handle keeps both trees mapped until it is
-// freed, even if they are closed first.
-//
-// # Safety
-//
-// `a` and `b` are NULL or open trees; `out` is NULL or points at writable storage for one
-// pointer.
+/**
+ * Makes a pair handle for trees `a` and `b` (they may be the same tree): checks that they
+ * store the same volume type and precision (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
+ * and prepares the traversal once. `*out` is the handle, to be released with
+ * `obbtree_pair_free`; NULL on failure. The handle keeps both trees mapped until it is
+ * freed, even if they are closed first.
+ *
+ * # Safety
+ *
+ * `a` and `b` are NULL or open trees; `out` is NULL or points at writable storage for one
+ * pointer.
+ */
 enum ObbtreeStatus obbtree_pair_new(const struct ObbtreeTree *a,
                                     const struct ObbtreeTree *b,
                                     struct ObbtreePair **out);
 
-// Releases a pair handle (and, if its trees were closed, their maps). NULL is ignored.
-//
-// # Safety
-//
-// `pair` is NULL or a handle from [`obbtree_pair_new`] not yet freed; no other thread is
-// using it, and it is not used after this call.
+/**
+ * Releases a pair handle (and, if its trees were closed, their maps). NULL is ignored.
+ *
+ * # Safety
+ *
+ * `pair` is NULL or a handle from `obbtree_pair_new` not yet freed; no other thread is
+ * using it, and it is not used after this call.
+ */
 void obbtree_pair_free(struct ObbtreePair *pair);
 
-// Collision between A at `pose_a` and B at `pose_b`: every contacting triangle pair,
-// sorted by (A, B) id, or with `first_contact` the first one found (stops there: the
-// cheapest yes/no answer).
-//
-// `*out` gets the answer; the pairs go to `pairs`, which holds `capacity` of them. Pass
-// NULL and 0 for the count only. When `pairs` is too short the call returns
-// `OBBTREE_STATUS_BUFFER_TOO_SMALL` with `*out` complete (`out->pair_count` is the size
-// needed) and the first `capacity` pairs written.
-//
-// # Safety
-//
-// `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
-// doubles; `pairs` is NULL or points at `capacity` writable pairs; `out` is NULL or points
-// at a writable result. Output buffers do not overlap the inputs.
+/**
+ * Collision between A at `pose_a` and B at `pose_b`: every contacting triangle pair,
+ * sorted by (A, B) id, or with `first_contact` the first one found (stops there: the
+ * cheapest yes/no answer).
+ *
+ * `*out` gets the answer; the pairs go to `pairs`, which holds `capacity` of them. Pass
+ * NULL and 0 for the count only. When `pairs` is too short the call returns
+ * `OBBTREE_STATUS_BUFFER_TOO_SMALL` with `*out` complete (`out->pair_count` is the size
+ * needed) and the first `capacity` pairs written.
+ *
+ * # Safety
+ *
+ * `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
+ * doubles; `pairs` is NULL or points at `capacity` writable pairs; `out` is NULL or points
+ * at a writable result. Output buffers do not overlap the inputs.
+ */
 enum ObbtreeStatus obbtree_pair_collide(struct ObbtreePair *pair,
                                         const double *pose_a,
                                         const double *pose_b,
@@ -334,18 +512,20 @@ enum ObbtreeStatus obbtree_pair_collide(struct ObbtreePair *pair,
                                         size_t capacity,
                                         struct ObbtreeCollideResult *out);
 
-// The separation distance between A at `pose_a` and B at `pose_b`, with the closest
-// points and triangles. Exact with both errors 0; otherwise the distance `d` returned and
-// the true one `d*` satisfy `d* <= d <= max(d* (1 + rel_err), d* + abs_err)`. With a
-// finite `max_distance` (world units; pass `INFINITY` for none), models at least that far
-// apart give `found = 0` and distance +infinity, and pairs of volumes that far apart are
-// never opened. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error, or a
-// negative or NaN `max_distance`.
-//
-// # Safety
-//
-// `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
-// doubles; `out` is NULL or points at a writable result.
+/**
+ * The separation distance between A at `pose_a` and B at `pose_b`, with the closest
+ * points and triangles. Exact with both errors 0; otherwise the distance `d` returned and
+ * the true one `d*` satisfy `d* <= d <= max(d* (1 + rel_err), d* + abs_err)`. With a
+ * finite `max_distance` (world units; pass `INFINITY` for none), models at least that far
+ * apart give `found = 0` and distance +infinity, and pairs of volumes that far apart are
+ * never opened. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error, or a
+ * negative or NaN `max_distance`.
+ *
+ * # Safety
+ *
+ * `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
+ * doubles; `out` is NULL or points at a writable result.
+ */
 enum ObbtreeStatus obbtree_pair_distance(struct ObbtreePair *pair,
                                          const double *pose_a,
                                          const double *pose_b,
@@ -354,55 +534,61 @@ enum ObbtreeStatus obbtree_pair_distance(struct ObbtreePair *pair,
                                          double max_distance,
                                          struct ObbtreeDistanceResult *out);
 
-// Whether A at `pose_a` and B at `pose_b` come closer than `tolerance` (world units, at
-// least 0), stopping as soon as that is known; with `closer`, a pair closer than the
-// tolerance. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite tolerance.
-//
-// # Safety
-//
-// `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
-// doubles; `out` is NULL or points at a writable result.
+/**
+ * Whether A at `pose_a` and B at `pose_b` come closer than `tolerance` (world units, at
+ * least 0), stopping as soon as that is known; with `closer`, a pair closer than the
+ * tolerance. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite tolerance.
+ *
+ * # Safety
+ *
+ * `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
+ * doubles; `out` is NULL or points at a writable result.
+ */
 enum ObbtreeStatus obbtree_pair_within(struct ObbtreePair *pair,
                                        const double *pose_a,
                                        const double *pose_b,
                                        double tolerance,
                                        struct ObbtreeToleranceResult *out);
 
-// The span of A at `pose_a` and B at `pose_b`: the largest distance between a point of A
-// and a point of B, with the pair realising it.
-//
-// # Safety
-//
-// `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
-// doubles; `out` is NULL or points at a writable result.
+/**
+ * The span of A at `pose_a` and B at `pose_b`: the largest distance between a point of A
+ * and a point of B, with the pair realising it.
+ *
+ * # Safety
+ *
+ * `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
+ * doubles; `out` is NULL or points at a writable result.
+ */
 enum ObbtreeStatus obbtree_pair_span(struct ObbtreePair *pair,
                                      const double *pose_a,
                                      const double *pose_b,
                                      struct ObbtreeSpanResult *out);
 
-// Collision for a batch of poses, in parallel: query `i` places A at pose `i` of
-// `poses_a` and B at pose `i` of `poses_b` (12 doubles each, one after the other). The
-// counts are equal, or one is 1 and that pose is used for every query (broadcast); the
-// batch has `max(count_a, count_b)` queries and `results` holds `results_len` answers,
-// which must equal it. `threads` 0 uses rayon's global pool (one thread per core, or
-// `RAYON_NUM_THREADS`), otherwise a pool of that many threads made for the call.
-//
-// The pairs of every query go to `pairs` one after the other in pose order
-// (`results[i].pair_offset` is where query `i`'s begin); `*pairs_total` (if not NULL)
-// gets the number of them all. Pass NULL and 0 for counts only. When `pairs` is too short
-// the call returns `OBBTREE_STATUS_BUFFER_TOO_SMALL` with every result complete and the
-// first `capacity` pairs written.
-//
-// Errors name the pose: `OBBTREE_STATUS_POSE` for a bad pose (checked before any query),
-// the first failing query's error otherwise.
-//
-// # Safety
-//
-// `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
-// `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
-// `results_len` writable results; `pairs` is NULL or points at `capacity` writable
-// pairs; `pairs_total` is NULL or writable. Output buffers do not overlap each other or
-// the inputs.
+/**
+ * Collision for a batch of poses, in parallel: query `i` places A at pose `i` of
+ * `poses_a` and B at pose `i` of `poses_b` (12 doubles each, one after the other). The
+ * counts are equal, or one is 1 and that pose is used for every query (broadcast); the
+ * batch has `max(count_a, count_b)` queries and `results` holds `results_len` answers,
+ * which must equal it. `threads` 0 uses rayon's global pool (one thread per core, or
+ * `RAYON_NUM_THREADS`), otherwise a pool of that many threads made for the call.
+ *
+ * The pairs of every query go to `pairs` one after the other in pose order
+ * (`results[i].pair_offset` is where query `i`'s begin); `*pairs_total` (if not NULL)
+ * gets the number of them all. Pass NULL and 0 for counts only. When `pairs` is too short
+ * the call returns `OBBTREE_STATUS_BUFFER_TOO_SMALL` with every result complete and the
+ * first `capacity` pairs written.
+ *
+ * Errors name the pose: `OBBTREE_STATUS_POSE` for a bad pose (checked before any query),
+ * the first failing query's error otherwise.
+ *
+ * # Safety
+ *
+ * `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
+ * `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
+ * `results_len` writable results; `pairs` is NULL or points at `capacity` writable
+ * pairs; `pairs_total` is NULL or writable. Output buffers do not overlap each other or
+ * the inputs.
+ */
 enum ObbtreeStatus obbtree_collide_batch(const struct ObbtreeTree *a,
                                          const double *poses_a,
                                          size_t count_a,
@@ -417,14 +603,16 @@ enum ObbtreeStatus obbtree_collide_batch(const struct ObbtreeTree *a,
                                          size_t capacity,
                                          size_t *pairs_total);
 
-// [`obbtree_pair_distance`] for a batch of poses, in parallel; the poses, counts,
-// `threads` and `results_len` as for [`obbtree_collide_batch`].
-//
-// # Safety
-//
-// `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
-// `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
-// `results_len` writable results, not overlapping the inputs.
+/**
+ * `obbtree_pair_distance` for a batch of poses, in parallel; the poses, counts,
+ * `threads` and `results_len` as for `obbtree_collide_batch`.
+ *
+ * # Safety
+ *
+ * `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
+ * `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
+ * `results_len` writable results, not overlapping the inputs.
+ */
 enum ObbtreeStatus obbtree_distance_batch(const struct ObbtreeTree *a,
                                           const double *poses_a,
                                           size_t count_a,
@@ -438,14 +626,16 @@ enum ObbtreeStatus obbtree_distance_batch(const struct ObbtreeTree *a,
                                           struct ObbtreeDistanceResult *results,
                                           size_t results_len);
 
-// [`obbtree_pair_within`] for a batch of poses, in parallel; the poses, counts, `threads`
-// and `results_len` as for [`obbtree_collide_batch`].
-//
-// # Safety
-//
-// `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
-// `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
-// `results_len` writable results, not overlapping the inputs.
+/**
+ * `obbtree_pair_within` for a batch of poses, in parallel; the poses, counts, `threads`
+ * and `results_len` as for `obbtree_collide_batch`.
+ *
+ * # Safety
+ *
+ * `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
+ * `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
+ * `results_len` writable results, not overlapping the inputs.
+ */
 enum ObbtreeStatus obbtree_within_batch(const struct ObbtreeTree *a,
                                         const double *poses_a,
                                         size_t count_a,
@@ -457,14 +647,16 @@ enum ObbtreeStatus obbtree_within_batch(const struct ObbtreeTree *a,
                                         struct ObbtreeToleranceResult *results,
                                         size_t results_len);
 
-// [`obbtree_pair_span`] for a batch of poses, in parallel; the poses, counts, `threads`
-// and `results_len` as for [`obbtree_collide_batch`].
-//
-// # Safety
-//
-// `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
-// `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
-// `results_len` writable results, not overlapping the inputs.
+/**
+ * `obbtree_pair_span` for a batch of poses, in parallel; the poses, counts, `threads`
+ * and `results_len` as for `obbtree_collide_batch`.
+ *
+ * # Safety
+ *
+ * `a`, `b` are NULL or open trees; `poses_a` (`poses_b`) is NULL or points at
+ * `12 * count_a` (`12 * count_b`) readable doubles; `results` is NULL or points at
+ * `results_len` writable results, not overlapping the inputs.
+ */
 enum ObbtreeStatus obbtree_span_batch(const struct ObbtreeTree *a,
                                       const double *poses_a,
                                       size_t count_a,

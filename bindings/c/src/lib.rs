@@ -8,8 +8,8 @@
 //!
 //! Conventions of every entry point:
 //!
-//! - it returns an [`ObbtreeStatus`]; on any status but `OBBTREE_STATUS_OK`,
-//!   [`obbtree_last_error`] gives a one-line message (the CLI's wording for the same error);
+//! - it returns an `ObbtreeStatus`; on any status but `OBBTREE_STATUS_OK`,
+//!   `obbtree_last_error` gives a one-line message (the CLI's wording for the same error);
 //! - no Rust panic crosses the boundary: an internal error becomes
 //!   `OBBTREE_STATUS_INTERNAL_ERROR`;
 //! - null or misaligned pointers, counts that do not fit and out-of-range options are
@@ -18,8 +18,8 @@
 //!   (`world = R p + t`); it must be rigid (orthonormal within 1e-6, determinant +1, every
 //!   number finite), as the CLI requires.
 //!
-//! Threads: an [`ObbtreeTree`] may be used by any number of threads at once. An
-//! [`ObbtreePair`] is used by one thread at a time (it holds the traversal scratch); a
+//! Threads: an `ObbtreeTree` may be used by any number of threads at once. An
+//! `ObbtreePair` is used by one thread at a time (it holds the traversal scratch); a
 //! second thread calling into a handle in use gets `OBBTREE_STATUS_BUSY`, never a race.
 #![deny(
     unsafe_op_in_unsafe_fn,
@@ -47,7 +47,7 @@ use std::sync::{Arc, Mutex, TryLockError};
 // Types seen from C
 // ---------------------------------------------------------------------------------------
 
-/// What a call did: `OBBTREE_STATUS_OK`, or why it failed (then [`obbtree_last_error`] says
+/// What a call did: `OBBTREE_STATUS_OK`, or why it failed (then `obbtree_last_error` says
 /// more).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,15 +80,15 @@ pub enum ObbtreeStatus {
     InternalError = 11,
 }
 
-/// An open `.obbt` tree (opaque). Made by [`obbtree_open`] or [`obbtree_open_bytes`],
-/// released by [`obbtree_close`]. Read-only: any number of threads may query one tree at
+/// An open `.obbt` tree (opaque). Made by `obbtree_open` or `obbtree_open_bytes`,
+/// released by `obbtree_close`. Read-only: any number of threads may query one tree at
 /// once.
 pub struct ObbtreeTree {
     file: Arc<ObbtFile>,
 }
 
 /// Two trees checked to be queryable together, with the traversal scratch kept between
-/// queries (opaque). Made by [`obbtree_pair_new`], released by [`obbtree_pair_free`]. One
+/// queries (opaque). Made by `obbtree_pair_new`, released by `obbtree_pair_free`. One
 /// thread at a time: a handle may move between threads, but a call made while another
 /// thread is inside a call on the same handle returns `OBBTREE_STATUS_BUSY`. Give each
 /// thread its own handle.
@@ -601,8 +601,8 @@ fn new_tree(file: ObbtFile, out: &mut MaybeUninit<*mut ObbtreeTree>) {
 
 /// Opens the `.obbt` file at `path` (a NUL-terminated path in the system's encoding; UTF-8
 /// on Windows): memory-maps it and checks its header and directory, in constant time for
-/// any size. Does not check the sections: call [`obbtree_verify`] for a file from
-/// elsewhere. On success `*out` is the tree, to be released with [`obbtree_close`]; on
+/// any size. Does not check the sections: call `obbtree_verify` for a file from
+/// elsewhere. On success `*out` is the tree, to be released with `obbtree_close`; on
 /// failure `*out` is NULL (`OBBTREE_STATUS_IO`, `OBBTREE_STATUS_FORMAT`).
 ///
 /// Do not modify the file in place while it is open (replacing it by renaming another file
@@ -643,8 +643,8 @@ pub unsafe extern "C" fn obbtree_open(
 /// asset embedded in the executable. The bytes are copied into a 64-byte aligned buffer
 /// owned by the tree (the library views sections in place, which needs that alignment),
 /// so `data` may have any alignment and may be freed as soon as this returns. The
-/// header and directory are checked as by [`obbtree_open`]; on success `*out` is the tree,
-/// to be released with [`obbtree_close`], on failure NULL (`OBBTREE_STATUS_FORMAT`).
+/// header and directory are checked as by `obbtree_open`; on success `*out` is the tree,
+/// to be released with `obbtree_close`, on failure NULL (`OBBTREE_STATUS_FORMAT`).
 ///
 /// # Safety
 ///
@@ -675,7 +675,7 @@ pub unsafe extern "C" fn obbtree_open_bytes(
 ///
 /// # Safety
 ///
-/// `tree` is NULL or a tree from [`obbtree_open`] / [`obbtree_open_bytes`] not yet closed;
+/// `tree` is NULL or a tree from `obbtree_open` / `obbtree_open_bytes` not yet closed;
 /// no other thread is using it, and it is not used after this call.
 #[no_mangle]
 pub unsafe extern "C" fn obbtree_close(tree: *mut ObbtreeTree) {
@@ -812,7 +812,7 @@ pub unsafe extern "C" fn obbtree_pose_orthonormalize(
 /// Makes a pair handle for trees `a` and `b` (they may be the same tree): checks that they
 /// store the same volume type and precision (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
 /// and prepares the traversal once. `*out` is the handle, to be released with
-/// [`obbtree_pair_free`]; NULL on failure. The handle keeps both trees mapped until it is
+/// `obbtree_pair_free`; NULL on failure. The handle keeps both trees mapped until it is
 /// freed, even if they are closed first.
 ///
 /// # Safety
@@ -856,7 +856,7 @@ pub unsafe extern "C" fn obbtree_pair_new(
 ///
 /// # Safety
 ///
-/// `pair` is NULL or a handle from [`obbtree_pair_new`] not yet freed; no other thread is
+/// `pair` is NULL or a handle from `obbtree_pair_new` not yet freed; no other thread is
 /// using it, and it is not used after this call.
 #[no_mangle]
 pub unsafe extern "C" fn obbtree_pair_free(pair: *mut ObbtreePair) {
@@ -1346,8 +1346,8 @@ impl<I: Iterator> Iterator for Counted<I> {
 
 impl<I: Iterator> ExactSizeIterator for Counted<I> {}
 
-/// [`obbtree_pair_distance`] for a batch of poses, in parallel; the poses, counts,
-/// `threads` and `results_len` as for [`obbtree_collide_batch`].
+/// `obbtree_pair_distance` for a batch of poses, in parallel; the poses, counts,
+/// `threads` and `results_len` as for `obbtree_collide_batch`.
 ///
 /// # Safety
 ///
@@ -1399,8 +1399,8 @@ pub unsafe extern "C" fn obbtree_distance_batch(
     })
 }
 
-/// [`obbtree_pair_within`] for a batch of poses, in parallel; the poses, counts, `threads`
-/// and `results_len` as for [`obbtree_collide_batch`].
+/// `obbtree_pair_within` for a batch of poses, in parallel; the poses, counts, `threads`
+/// and `results_len` as for `obbtree_collide_batch`.
 ///
 /// # Safety
 ///
@@ -1450,8 +1450,8 @@ pub unsafe extern "C" fn obbtree_within_batch(
     })
 }
 
-/// [`obbtree_pair_span`] for a batch of poses, in parallel; the poses, counts, `threads`
-/// and `results_len` as for [`obbtree_collide_batch`].
+/// `obbtree_pair_span` for a batch of poses, in parallel; the poses, counts, `threads`
+/// and `results_len` as for `obbtree_collide_batch`.
 ///
 /// # Safety
 ///
@@ -1527,6 +1527,52 @@ mod tests {
         let status = guard(|| Err(Error::bad("a\0b")));
         assert_eq!(status, ObbtreeStatus::BadArgument);
         assert_eq!(last_error(), "a\\0b");
+    }
+
+    /// A pair handle of the cow's tree with itself (built in memory).
+    fn cow_pair() -> *mut ObbtreePair {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/cow.obj");
+        let mesh = obbtree::mesh::TriMesh::load(root.as_ref()).expect("cow loads");
+        let file = obbtree::build::build(&mesh, &Default::default(), None).expect("builds");
+        let tree = ObbtreeTree {
+            file: Arc::new(file),
+        };
+        let mut pair = std::ptr::null_mut();
+        // SAFETY: a live tree and a writable pointer; the handle keeps the file alive
+        // after `tree` is dropped.
+        let status = unsafe { obbtree_pair_new(&tree, &tree, &mut pair) };
+        assert_eq!(status, ObbtreeStatus::Ok);
+        pair
+    }
+
+    fn span(pair: *mut ObbtreePair) -> ObbtreeStatus {
+        let pose = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let mut out = MaybeUninit::<ObbtreeSpanResult>::uninit();
+        // SAFETY: a live handle, 12 doubles each, a writable result.
+        unsafe { obbtree_pair_span(pair, pose.as_ptr(), pose.as_ptr(), out.as_mut_ptr()) }
+    }
+
+    #[test]
+    fn a_handle_in_use_is_busy_and_a_poisoned_one_refuses() {
+        let pair = cow_pair();
+        // SAFETY: the handle is live until freed below.
+        let handle = unsafe { &*pair };
+        {
+            // Another thread inside a call holds the lock: this call must not wait or race.
+            let _inside = handle.state.lock().expect("not poisoned");
+            assert_eq!(span(pair), ObbtreeStatus::Busy);
+            assert!(last_error().contains("in use by another thread"));
+        }
+        assert_eq!(span(pair), ObbtreeStatus::Ok);
+        // A panic while the lock was held (a bug) leaves the handle refusing, not broken.
+        let _ = catch_unwind(AssertUnwindSafe(|| {
+            let _inside = handle.state.lock();
+            panic!("poison");
+        }));
+        assert_eq!(span(pair), ObbtreeStatus::InternalError);
+        assert!(last_error().contains("free it and make a new one"));
+        // SAFETY: made above, freed once.
+        unsafe { obbtree_pair_free(pair) };
     }
 
     #[test]
