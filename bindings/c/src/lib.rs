@@ -336,16 +336,21 @@ impl From<QueryError> for Error {
 }
 
 thread_local! {
-    /// The message of this thread's latest call (empty after a success).
-    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+    /// The message of this thread's latest call, `None` after a success (so that a
+    /// successful call allocates nothing for it).
+    static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
 }
 
 /// Records `message` as this thread's last error (NUL bytes, which C strings cannot hold,
-/// become `\0`).
-fn set_last_error(message: &str) {
-    let text = CString::new(message.replace('\0', "\\0")).unwrap_or_default();
+/// become `\0`), or clears it for `None`.
+fn set_last_error(message: Option<&str>) {
+    let text = message.map(|m| CString::new(m.replace('\0', "\\0")).unwrap_or_default());
     // Fails only while the thread is being torn down, when nobody can read it any more.
-    let _ = LAST_ERROR.try_with(|last| last.replace(text));
+    let _ = LAST_ERROR.try_with(|last| {
+        if text.is_some() || last.borrow().is_some() {
+            last.replace(text);
+        }
+    });
 }
 
 /// Runs the body of an entry point: its error becomes a status and this thread's last
@@ -354,11 +359,11 @@ fn set_last_error(message: &str) {
 fn guard(body: impl FnOnce() -> Result<(), Error>) -> ObbtreeStatus {
     match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(())) => {
-            set_last_error("");
+            set_last_error(None);
             ObbtreeStatus::Ok
         }
         Ok(Err(e)) => {
-            set_last_error(&e.message);
+            set_last_error(Some(&e.message));
             e.status
         }
         Err(payload) => {
@@ -367,9 +372,9 @@ fn guard(body: impl FnOnce() -> Result<(), Error>) -> ObbtreeStatus {
                 .map(|s| s.to_string())
                 .or_else(|| payload.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown panic".into());
-            set_last_error(&format!(
+            set_last_error(Some(&format!(
                 "internal error in obbtree (please report it): {what}"
-            ));
+            )));
             ObbtreeStatus::InternalError
         }
     }
@@ -560,7 +565,7 @@ pub extern "C" fn obbtree_version() -> *const c_char {
 pub extern "C" fn obbtree_last_error() -> *const c_char {
     guard_value(c"".as_ptr(), || {
         LAST_ERROR
-            .try_with(|last| last.borrow().as_ptr())
+            .try_with(|last| last.borrow().as_deref().map_or(c"".as_ptr(), CStr::as_ptr))
             .unwrap_or(c"".as_ptr())
     })
 }

@@ -365,6 +365,35 @@ fn the_c_example_answers_as_the_rust_api() {
 }
 
 #[test]
+fn the_header_compiles_as_c99_and_cxx() {
+    let include = Path::new(env!("CARGO_MANIFEST_DIR")).join("include");
+    let dir = common::scratch("header");
+    let c = dir.join("uses_header.c");
+    std::fs::write(
+        &c,
+        "#include \"obbtree.h\"\nint main(void) { ObbtreeTree *t = NULL; \
+         return obbtree_open(\"x\", &t) == OBBTREE_STATUS_OK; }\n",
+    )
+    .expect("source written");
+    for (compiler, language, standard) in [("cc", "c", "-std=c99"), ("c++", "c++", "-std=c++11")] {
+        run(Command::new(compiler)
+            .args([
+                "-x",
+                language,
+                standard,
+                "-pedantic",
+                "-Wall",
+                "-Wextra",
+                "-Werror",
+            ])
+            .args(["-fsyntax-only", "-I"])
+            .arg(&include)
+            .arg(&c));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn the_readme_shows_the_example() {
     let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
     let readme = std::fs::read_to_string(crate_dir.join("README.md")).expect("README.md");
