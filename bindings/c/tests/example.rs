@@ -268,14 +268,12 @@ fn expected(tree: &Path, printed: &Answers) -> Answers {
     e.0
 }
 
-/// The directory the library was built into: the test binary runs from its `deps/`.
+/// The directory of the library this test run built: cargo compiles the crate's cdylib
+/// and staticlib beside the test binaries, in `target/<profile>/deps/` (only `cargo build`
+/// also copies them up to `target/<profile>/`, where a copy may be stale during a test).
 fn library_dir() -> PathBuf {
     let exe = std::env::current_exe().expect("test executable path");
-    let dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>/deps/<test>")
-        .to_path_buf();
+    let dir = exe.parent().expect("target/<profile>/deps").to_path_buf();
     for lib in ["libobbtree_c.a", "libobbtree_c.so"] {
         assert!(
             dir.join(lib).is_file(),
