@@ -195,14 +195,9 @@ def random_poses(n: int, spread: float, seed: int = 1) -> np.ndarray:
     return np.concatenate([r, rng.uniform(-spread, spread, size=(n, 3))], axis=1)
 
 
-# Tasks defined here are pickled by value, so workers need not import this file.
-try:
-    import cloudpickle
-
-    if __name__ != "__main__":
-        cloudpickle.register_pickle_by_value(sys.modules[__name__])
-except ImportError:  # pragma: no cover - dask always brings cloudpickle
-    pass
+# Run as a script, the tasks are functions of __main__, which Dask pickles by value; used
+# as a module (`import dask_batch`), the workers must import it too: put it on their path
+# or send it with client.upload_file("dask_batch.py").
 
 
 def main(argv=None) -> None:
