@@ -14,6 +14,12 @@
 #define OBBTREE_NO_TRIANGLE UINT32_MAX
 
 /**
+ * The most threads a batch call starts for itself (a larger `threads` is an error rather
+ * than an attempt to start that many).
+ */
+#define OBBTREE_MAX_THREADS 1024
+
+/**
  * What a call did: `OBBTREE_STATUS_OK`, or why it failed (then `obbtree_last_error` says
  * more).
  */
@@ -570,7 +576,8 @@ enum ObbtreeStatus obbtree_pair_span(struct ObbtreePair *pair,
  * counts are equal, or one is 1 and that pose is used for every query (broadcast); the
  * batch has `max(count_a, count_b)` queries and `results` holds `results_len` answers,
  * which must equal it. `threads` 0 uses rayon's global pool (one thread per core, or
- * `RAYON_NUM_THREADS`), otherwise a pool of that many threads made for the call.
+ * `RAYON_NUM_THREADS`), otherwise a pool of that many threads (at most
+ * `OBBTREE_MAX_THREADS`) made for the call.
  *
  * The pairs of every query go to `pairs` one after the other in pose order
  * (`results[i].pair_offset` is where query `i`'s begin); `*pairs_total` (if not NULL)

@@ -110,6 +110,10 @@ struct PairState {
 /// tolerance query with no pair closer than the tolerance).
 pub const OBBTREE_NO_TRIANGLE: u32 = u32::MAX;
 
+/// The most threads a batch call starts for itself (a larger `threads` is an error rather
+/// than an attempt to start that many).
+pub const OBBTREE_MAX_THREADS: usize = 1024;
+
 /// The bounding volume type a tree stores (the values are the file's header tags).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -1154,6 +1158,11 @@ impl<'a> Batch<'a> {
     ) -> Result<Batch<'a>, Error> {
         // SAFETY: NULL or open trees (the caller's contract).
         let (a, b) = unsafe { (deref(a, "a")?, deref(b, "b")?) };
+        if threads > OBBTREE_MAX_THREADS {
+            return Err(Error::bad(format!(
+                "threads is {threads}: at most {OBBTREE_MAX_THREADS} (0 for one per core)"
+            )));
+        }
         let n = match (count_a, count_b) {
             (x, y) if x == y => x,
             (1, y) => y,
@@ -1251,7 +1260,8 @@ impl<'a> Batch<'a> {
 /// counts are equal, or one is 1 and that pose is used for every query (broadcast); the
 /// batch has `max(count_a, count_b)` queries and `results` holds `results_len` answers,
 /// which must equal it. `threads` 0 uses rayon's global pool (one thread per core, or
-/// `RAYON_NUM_THREADS`), otherwise a pool of that many threads made for the call.
+/// `RAYON_NUM_THREADS`), otherwise a pool of that many threads (at most
+/// `OBBTREE_MAX_THREADS`) made for the call.
 ///
 /// The pairs of every query go to `pairs` one after the other in pose order
 /// (`results[i].pair_offset` is where query `i`'s begin); `*pairs_total` (if not NULL)

@@ -476,6 +476,11 @@ fn batch_arguments_are_checked_and_batches_equal_single_calls() {
         ObbtreeStatus::BadArgument,
         "results_len is 7",
     );
+    fails(
+        batch(1, &poses, 8, 100_000, &mut results, 8),
+        ObbtreeStatus::BadArgument,
+        "threads is 100000: at most 1024",
+    );
     let mut bad = poses.clone();
     bad[5][4] = 3.0;
     fails(
