@@ -1,6 +1,7 @@
 """Type stubs of the native module obbtree._obbtree (re-exported by ``obbtree``)."""
 
 import os
+import pathlib
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -52,7 +53,7 @@ class Tree:
     def source_ids(self) -> npt.NDArray[np.uint32]:
         """(m,) read-only view: the input-mesh id of each stored triangle."""
     @property
-    def path(self) -> Optional[str]:
+    def path(self) -> Optional[pathlib.Path]:
         """The file, or None for an in-memory tree."""
     @property
     def closed(self) -> bool:
@@ -138,10 +139,10 @@ class Scene:
     def names(self) -> List[str]:
         """The objects' names, in scene-file order."""
     @property
-    def frames(self) -> Optional[str]:
+    def frames(self) -> Optional[pathlib.Path]:
         """The frames file the scene file names, or None."""
     @property
-    def path(self) -> str:
+    def path(self) -> pathlib.Path:
         """The scene file."""
 
 def open(path: _Path) -> Tree:
