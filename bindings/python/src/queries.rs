@@ -220,6 +220,9 @@ fn readonly<'py>(array: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
     Ok(array)
 }
 
+/// One count of a [`Work`].
+type Count = fn(&Work) -> u64;
+
 /// The work of each pose as a dict of (N,) int64 arrays, keys as the CLI's `stats`.
 fn work_dict<'py>(py: Python<'py>, work: &[Work]) -> PyResult<Bound<'py, PyAny>> {
     let dict = PyDict::new(py);
@@ -228,7 +231,7 @@ fn work_dict<'py>(py: Python<'py>, work: &[Work]) -> PyResult<Bound<'py, PyAny>>
             .map(|w| i64::try_from(f(w)).unwrap_or(i64::MAX))
             .collect()
     };
-    let columns: [(&str, fn(&Work) -> u64); 7] = [
+    let columns: [(&str, Count); 7] = [
         ("bv_disjoint", |w| w.bv_disjoint),
         ("bv_overlap", |w| w.bv_overlap),
         ("tri_separated", |w| w.tri_separated),
