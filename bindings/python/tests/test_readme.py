@@ -1,4 +1,4 @@
-"""The README's "From Python" example runs as written (and prints what it says)."""
+"""The READMEs' "From Python" examples (the binding's and the root's) run as written."""
 
 import os
 import pathlib
@@ -9,8 +9,13 @@ import sys
 from conftest import HERE, REPO
 
 
-def test_readme_example(tmp_path):
-    text = (HERE.parent / "README.md").read_text()
+import pytest
+
+
+@pytest.mark.parametrize("readme", [HERE.parent / "README.md", REPO / "README.md"],
+                         ids=["binding", "root"])
+def test_readme_example(tmp_path, readme):
+    text = readme.read_text()
     section = text.split("## From Python", 1)[1]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     script = tmp_path / "example.py"
