@@ -42,7 +42,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
         None
     };
     if args.json {
-        let mut value = to_json(&info);
+        let mut value = info.to_json();
         if let (Some(levels), Some(object)) = (&levels, value.as_object_mut()) {
             object.insert("levels".into(), levels_json(levels));
         }
@@ -112,35 +112,6 @@ fn print_levels(levels: &[LevelStats]) -> Result<(), Failure> {
         )?;
     }
     Ok(())
-}
-
-/// The `info --json` object (field names are part of the CLI contract).
-pub fn to_json(info: &Info) -> serde_json::Value {
-    let sections: Vec<_> = info
-        .sections
-        .iter()
-        .map(|s| json!({"name": s.name(), "offset": s.offset, "bytes": s.length, "count": s.count, "stride": s.stride}))
-        .collect();
-    json!({
-        "version": format!("{}.{}", info.version.0, info.version.1),
-        "triangles": info.triangles,
-        "vertices": info.vertices,
-        "nodes": info.nodes,
-        "leaves": info.stats.shape.leaves,
-        "depth": info.stats.shape.depth,
-        "max_leaf_faces": info.stats.shape.max_leaf_faces,
-        "degenerate_triangles": info.stats.degenerate_triangles,
-        "bv": info.bv.name(),
-        "precision": info.precision.name(),
-        "fit": info.fit.name(),
-        "leaf_size": info.leaf_size,
-        "encoding": info.encoding.name(),
-        "bounds": {"min": info.stats.bounds_min, "max": info.stats.bounds_max},
-        "placement": {"scale": info.placement.scale, "offset": info.placement.offset},
-        "file_bytes": info.file_bytes,
-        "bytes_per_triangle": info.file_bytes as f64 / f64::from(info.triangles.max(1)),
-        "sections": sections,
-    })
 }
 
 fn print_text(name: &str, info: &Info) -> Result<(), Failure> {

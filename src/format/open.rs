@@ -121,6 +121,38 @@ pub struct Info {
     pub sections: Vec<SectionInfo>,
 }
 
+impl Info {
+    /// The `obbtree info --json` object: the header's facts under stable field names (the
+    /// CLI's and the Python binding's `Tree.info`).
+    pub fn to_json(&self) -> serde_json::Value {
+        let sections: Vec<_> = self
+            .sections
+            .iter()
+            .map(|s| serde_json::json!({"name": s.name(), "offset": s.offset, "bytes": s.length, "count": s.count, "stride": s.stride}))
+            .collect();
+        serde_json::json!({
+            "version": format!("{}.{}", self.version.0, self.version.1),
+            "triangles": self.triangles,
+            "vertices": self.vertices,
+            "nodes": self.nodes,
+            "leaves": self.stats.shape.leaves,
+            "depth": self.stats.shape.depth,
+            "max_leaf_faces": self.stats.shape.max_leaf_faces,
+            "degenerate_triangles": self.stats.degenerate_triangles,
+            "bv": self.bv.name(),
+            "precision": self.precision.name(),
+            "fit": self.fit.name(),
+            "leaf_size": self.leaf_size,
+            "encoding": self.encoding.name(),
+            "bounds": {"min": self.stats.bounds_min, "max": self.stats.bounds_max},
+            "placement": {"scale": self.placement.scale, "offset": self.placement.offset},
+            "file_bytes": self.file_bytes,
+            "bytes_per_triangle": self.file_bytes as f64 / f64::from(self.triangles.max(1)),
+            "sections": sections,
+        })
+    }
+}
+
 /// Code generic over the volume type, run once on the concrete view of a file (static
 /// dispatch: the match on the header tags happens once, not per node).
 pub trait TreeVisitor {

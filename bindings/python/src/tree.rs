@@ -8,11 +8,10 @@ use obbtree::build::{build as build_tree, BuildOptions, SphereFit};
 use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
 use obbtree::format::layout::SectionKind;
-use obbtree::format::{Info, ObbtFile};
+use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
 use obbtree::real::Precision;
 use pyo3::prelude::*;
-use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 use zerocopy::FromBytes;
@@ -130,35 +129,6 @@ where
 
 use pyo3::types::IntoPyDict;
 
-/// The `obbtree info --json` object of a file (the CLI's field names and layout).
-pub fn info_json(info: &Info) -> serde_json::Value {
-    let sections: Vec<_> = info
-        .sections
-        .iter()
-        .map(|s| json!({"name": s.name(), "offset": s.offset, "bytes": s.length, "count": s.count, "stride": s.stride}))
-        .collect();
-    json!({
-        "version": format!("{}.{}", info.version.0, info.version.1),
-        "triangles": info.triangles,
-        "vertices": info.vertices,
-        "nodes": info.nodes,
-        "leaves": info.stats.shape.leaves,
-        "depth": info.stats.shape.depth,
-        "max_leaf_faces": info.stats.shape.max_leaf_faces,
-        "degenerate_triangles": info.stats.degenerate_triangles,
-        "bv": info.bv.name(),
-        "precision": info.precision.name(),
-        "fit": info.fit.name(),
-        "leaf_size": info.leaf_size,
-        "encoding": info.encoding.name(),
-        "bounds": {"min": info.stats.bounds_min, "max": info.stats.bounds_max},
-        "placement": {"scale": info.placement.scale, "offset": info.placement.offset},
-        "file_bytes": info.file_bytes,
-        "bytes_per_triangle": info.file_bytes as f64 / f64::from(info.triangles.max(1)),
-        "sections": sections,
-    })
-}
-
 #[pymethods]
 impl Tree {
     /// What the tree holds, from its header alone: a dict with the keys of
@@ -168,7 +138,7 @@ impl Tree {
     #[getter]
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let file = self.file()?;
-        to_python(py, &info_json(&file.info()))
+        to_python(py, &file.info().to_json())
     }
 
     /// Checks the whole file (O(n)): checksums of the header and every section, zero
