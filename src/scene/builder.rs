@@ -92,10 +92,10 @@ impl SceneBuilder {
     /// # Errors
     ///
     /// A [`SceneError`] with origin `scene`, naming the object or rule and field at fault:
-    /// a name that is empty, repeated or not made of ASCII letters, digits, `_`, `.` and
-    /// `-`; assets of different volume types or precisions; a rule whose selector names no
-    /// object or group; or an effect with a clearance, relative error or maximum distance
-    /// out of range.
+    /// an object or group name that is empty or not made of ASCII letters, digits, `_`,
+    /// `.` and `-`; an object name used twice; assets of different volume types or
+    /// precisions; a rule whose selector names no object or group; or an effect with a
+    /// clearance, relative error or maximum distance out of range.
     ///
     /// # Examples
     ///
