@@ -25,8 +25,9 @@ use nalgebra::Vector3;
 /// # Errors
 ///
 /// [`ExperimentError::Generate`] or [`ExperimentError::Build`] if a sphere or its tree
-/// cannot be made, and [`ExperimentError::Query`] if a query fails (neither happens with
-/// the experiment's own parameters: these errors are bugs); [`ExperimentError::Levels`] if a tree's levels cannot be measured.
+/// cannot be made, [`ExperimentError::Query`] if a query fails, and
+/// [`ExperimentError::Levels`] if a tree's levels cannot be measured (none happens with
+/// the experiment's own parameters: these errors are bugs).
 pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, slices, per_decade, decades, queries): (u32, u32, i32, i32, u32) = match size {
         Size::Full => (101, 200, 4, 9, 100),

@@ -26,7 +26,7 @@ pub const VARIANTS: [(BvKind, Variant); 2] = [
 /// # Errors
 ///
 /// [`ExperimentError::Generate`] or [`ExperimentError::Build`] if a sphere or its tree
-/// cannot be made, and [`ExperimentError::Query`] if a query fails (neither happens with
+/// cannot be made, and [`ExperimentError::Query`] if a query fails (none happens with
 /// the experiment's own parameters: these errors are bugs).
 pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, slices, steps) = match size {
