@@ -157,6 +157,36 @@ impl PoseFormat {
     /// must have norm 1 within 1e-6); with it, a rotation matrix is replaced by the nearest
     /// rotation and a quaternion is normalised, refusing changes beyond [`MAX_REPAIR`] and
     /// reflections.
+    ///
+    /// # Errors
+    ///
+    /// - [`PoseError::WrongCount`] if `values` is not [`PoseFormat::numbers`] long.
+    /// - [`PoseError::NotFinite`] for a NaN or infinite number (with its index).
+    /// - [`PoseError::NotRigid`] for a [`PoseFormat::Matrix4`] whose last row is not
+    ///   `0 0 0 1`.
+    /// - Without `repair`: [`PoseError::NotUnitQuaternion`] for a quaternion whose norm is
+    ///   not 1 within 1e-6, and the errors of [`Pose::new`] for a matrix.
+    /// - With `repair`: [`PoseError::Reflection`] for a matrix with determinant ≤ 0, and
+    ///   [`PoseError::BeyondRepair`] for a change beyond [`MAX_REPAIR`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::query::{PoseError, PoseFormat};
+    ///
+    /// // Translation (1, 2, 3), then the quaternion w x y z of a half turn about z.
+    /// let format = PoseFormat::from_name("tq-wxyz").expect("a format");
+    /// let parsed = format.parse(&[1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0], false)?;
+    /// assert_eq!(parsed.pose.translation_vector().x, 1.0);
+    /// assert_eq!(parsed.correction, 0.0);
+    ///
+    /// // A slightly denormalised quaternion: refused as given, normalised with repair.
+    /// let rough = [1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.001];
+    /// assert!(matches!(format.parse(&rough, false), Err(PoseError::NotUnitQuaternion { .. })));
+    /// assert!(format.parse(&rough, true)?.correction > 0.0);
+    /// assert!(matches!(format.parse(&rough[..6], true), Err(PoseError::WrongCount { .. })));
+    /// # Ok::<(), PoseError>(())
+    /// ```
     pub fn parse(self, values: &[f64], repair: bool) -> Result<ParsedPose, PoseError> {
         if values.len() != self.numbers() {
             return Err(PoseError::WrongCount {
@@ -254,6 +284,31 @@ impl Pose {
 
     /// A pose from a rotation and a translation, refusing non-finite numbers, rotations not
     /// orthonormal within 1e-6, and reflections.
+    ///
+    /// # Errors
+    ///
+    /// - [`PoseError::NotFinite`] for a NaN or infinite entry (index in row-major order,
+    ///   rotation first).
+    /// - [`PoseError::NotOrthonormal`] if `rotationᵀ · rotation` differs from the identity
+    ///   by more than [`ORTHONORMAL_TOLERANCE`].
+    /// - [`PoseError::Reflection`] for a negative determinant.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::nalgebra::{Matrix3, Rotation3, Vector3};
+    /// use obbtree::query::{Pose, PoseError};
+    ///
+    /// let turn = Rotation3::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+    /// let pose = Pose::new(*turn.matrix(), Vector3::new(0.0, 0.0, 1.0))?;
+    /// let p = pose.apply(&Vector3::new(1.0, 0.0, 0.0)); // turned onto y, lifted by 1
+    /// assert!((p - Vector3::new(0.0, 1.0, 1.0)).norm() < 1e-12);
+    ///
+    /// let mirror = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+    /// assert!(matches!(Pose::new(mirror, Vector3::zeros()), Err(PoseError::Reflection { .. })));
+    /// assert!(matches!(Pose::new(2.0 * Matrix3::identity(), Vector3::zeros()), Err(PoseError::NotOrthonormal { .. })));
+    /// # Ok::<(), PoseError>(())
+    /// ```
     pub fn new(rotation: Matrix3<f64>, translation: Vector3<f64>) -> Result<Pose, PoseError> {
         let row_major = rotation.transpose();
         for (index, &value) in row_major.iter().chain(translation.iter()).enumerate() {
@@ -279,6 +334,23 @@ impl Pose {
 
     /// A pose from 12 numbers: the rotation row by row, then the translation
     /// ([`PoseFormat::RotationTranslation`], no repair).
+    ///
+    /// # Errors
+    ///
+    /// [`PoseError::WrongCount`] unless there are 12 numbers, then the errors of
+    /// [`Pose::new`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::query::Pose;
+    ///
+    /// let values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 4.0, 5.0, 6.0];
+    /// let pose = Pose::from_row_major(&values)?;
+    /// assert_eq!(pose, Pose::translation(4.0, 5.0, 6.0));
+    /// assert_eq!(pose.row_major(), values);
+    /// # Ok::<(), obbtree::query::PoseError>(())
+    /// ```
     pub fn from_row_major(values: &[f64]) -> Result<Pose, PoseError> {
         Ok(PoseFormat::RotationTranslation.parse(values, false)?.pose)
     }
@@ -294,6 +366,11 @@ impl Pose {
 
     /// A pose from a unit quaternion and a translation (world units). nalgebra keeps
     /// `UnitQuaternion` normalised, so only non-finite numbers are refused.
+    ///
+    /// # Errors
+    ///
+    /// [`PoseError::NotFinite`] for a NaN or infinite number (and, in principle, the other
+    /// errors of [`Pose::new`] for the rotation matrix of the quaternion).
     pub fn from_quaternion(
         rotation: &UnitQuaternion<f64>,
         translation: &Vector3<f64>,
@@ -302,6 +379,24 @@ impl Pose {
     }
 
     /// A pose from a nalgebra isometry (`world = iso * p`).
+    ///
+    /// # Errors
+    ///
+    /// As [`Pose::from_quaternion`]: [`PoseError::NotFinite`] for a NaN or infinite number.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::nalgebra::{Isometry3, Point3, Vector3};
+    /// use obbtree::query::Pose;
+    ///
+    /// let iso = Isometry3::new(Vector3::new(1.0, 2.0, 3.0), Vector3::new(0.0, 0.0, 0.5));
+    /// let pose = Pose::from_isometry(&iso)?;
+    /// let p = Vector3::new(1.0, 1.0, 1.0);
+    /// assert!((pose.apply(&p) - (iso * Point3::from(p)).coords).norm() < 1e-12);
+    /// assert!(Pose::from_isometry(&Isometry3::translation(f64::NAN, 0.0, 0.0)).is_err());
+    /// # Ok::<(), obbtree::query::PoseError>(())
+    /// ```
     pub fn from_isometry(isometry: &Isometry3<f64>) -> Result<Pose, PoseError> {
         Pose::from_quaternion(&isometry.rotation, &isometry.translation.vector)
     }

@@ -121,6 +121,12 @@ impl LevelStats {
 /// Every level of `tree` from the root down, measured ([`LevelStats`]). Walks each node
 /// once; a damaged, unverified tree gives the defect of the first bad node met, or
 /// [`NodeDefect::BadChildren`] if some node is reachable twice.
+///
+/// # Errors
+///
+/// On a damaged tree only (a verified one has none): [`NodeDefect::Missing`],
+/// [`NodeDefect::BadChildren`] or [`NodeDefect::BadFaces`] for the first bad node met
+/// ([`TreeView::node_kind`]), and [`NodeDefect::BadChildren`] for a node reachable twice.
 pub fn level_stats<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
 ) -> Result<Vec<LevelStats>, NodeDefect> {

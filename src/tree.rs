@@ -197,6 +197,26 @@ impl Encoding {
     }
 
     /// Packs a reference, refusing anything the encoding cannot represent exactly.
+    ///
+    /// # Errors
+    ///
+    /// - [`EncodeError::BadCount`] for a child or face count the encoding cannot hold
+    ///   (zero, too many, or not exactly 2 children / 1 face in the binary encoding).
+    /// - [`EncodeError::IndexTooLarge`] for a first child or face index beyond the
+    ///   encoding's field (or a first child of 0, the root).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::tree::{EncodeError, Encoding, NodeRef};
+    ///
+    /// let leaf = NodeRef::Leaf { first: 7, count: 1 };
+    /// let packed = Encoding::Binary.encode(leaf)?;
+    /// assert_eq!(Encoding::Binary.decode(packed), leaf);
+    /// let wide = NodeRef::Internal { first: 1, count: 3 };
+    /// assert!(matches!(Encoding::Binary.encode(wide), Err(EncodeError::BadCount { .. })));
+    /// # Ok::<(), EncodeError>(())
+    /// ```
     pub fn encode(self, r: NodeRef) -> Result<u32, EncodeError> {
         let too_large = |what, index, limit| EncodeError::IndexTooLarge {
             what,
@@ -346,6 +366,13 @@ impl<'a, B: BoundingVolume> TreeView<'a, B> {
     /// What node `index` holds, checked: its children (which must lie after it and inside
     /// the node array, so every descent terminates) or its faces (inside the face array).
     /// The one decoder of references that the traversal, `verify` and the tests share.
+    ///
+    /// # Errors
+    ///
+    /// [`NodeDefect::Missing`] for an index past the node array,
+    /// [`NodeDefect::BadChildren`] for children past the array or not after the node, and
+    /// [`NodeDefect::BadFaces`] for faces past the face array: only in a damaged file,
+    /// never after [`ObbtFile::verify`](crate::format::ObbtFile::verify).
     #[inline]
     pub fn node_kind(&self, index: u32) -> Result<NodeKind, NodeDefect> {
         let node = self.node(index).ok_or(NodeDefect::Missing)?;

@@ -45,10 +45,9 @@ pub struct BuildOptions {
     pub hull_max_points: u32,
     /// Also fit each node's volume to the model's own axes and keep that one wherever its
     /// volume is smaller than the fitted frame's (default on). Parts modelled along their
-    /// axes (CAD) have many nodes whose covariance frame is tilted against their flat sides:
-    /// with the turned copy of `tree_work`, fandisk's distance queries visited 56% fewer
-    /// node pairs, the bunny, pig and cow 5 to 14% fewer, and every mesh's collisions 1 to
-    /// 6% fewer box tests, for 4 to 6% more build time. Off (with
+    /// axes (CAD) have many nodes whose covariance frame is tilted against their flat sides;
+    /// on them the model's axes make far fewer node pairs and box tests, for a little more
+    /// build time (the figures are in docs/results). Off (with
     /// [`BuildOptions::hull_min_faces`] 1 and [`BuildOptions::hull_max_points`] `u32::MAX`)
     /// gives §3.4 exactly.
     pub model_axes: bool,
@@ -91,8 +90,7 @@ pub enum SphereFit {
     #[default]
     BoxCentre,
     /// At the centre of the smallest ball containing the node's vertices (Welzl's
-    /// algorithm): the tightest sphere, up to 16% smaller in radius, for a build that costs
-    /// more. The dissertation's sphere trees are compared with these.
+    /// algorithm): the tightest sphere, for a build that costs more. The dissertation's sphere trees are compared with these.
     Minimal,
 }
 
@@ -107,11 +105,9 @@ pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
 /// The default [`BuildOptions::hull_max_points`]. The top levels of a tree hold most of the
 /// remaining hull work, all the more on convex shapes, whose every vertex is a hull vertex;
 /// the hull of an evenly spaced sample of a dense surface has nearly the same covariance.
-/// Measured with `examples/tree_work` against the hull over every vertex (one-thread build;
-/// summed box tests of 40 poses): the 40k lat/long sphere built in 75 instead of 105 ms, the
-/// bunny in 108 instead of 120 ms, fandisk and pig 4 and 10% faster; over those and the cow,
-/// box tests moved by −1.1 to +0.2% in collision and −4.6 to +1.1% in distance (samples of
-/// 1,024 to 8,192 points all stayed within a few percent).
+/// Against the hull over every vertex (`examples/tree_work`), this sample built faster on
+/// every benchmark mesh and left the box tests of collision and distance queries nearly
+/// unchanged (the figures are in docs/results).
 pub const DEFAULT_HULL_MAX_POINTS: u32 = 2048;
 
 /// The least [`BuildOptions::hull_max_points`]: a solid hull needs four points.
@@ -142,6 +138,21 @@ impl BuildOptions {
     /// The checks of the options alone, before any mesh is read: `leaf_size` in 1..=128,
     /// `hull_min_faces` at least 1, `hull_max_points` at least 4, a finite `scale`
     /// greater than 0, and minimal spheres only for sphere trees. [`build`] runs them too.
+    ///
+    /// # Errors
+    ///
+    /// The first check that fails: [`BuildError::LeafSize`], [`BuildError::HullMinFaces`],
+    /// [`BuildError::HullMaxPoints`], [`BuildError::Scale`] or [`BuildError::SphereFit`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::build::{BuildError, BuildOptions};
+    ///
+    /// assert!(BuildOptions::default().validate().is_ok());
+    /// let options = BuildOptions { leaf_size: 0, ..Default::default() };
+    /// assert!(matches!(options.validate(), Err(BuildError::LeafSize(0))));
+    /// ```
     pub fn validate(&self) -> Result<(), BuildError> {
         if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&self.leaf_size) {
             return Err(BuildError::LeafSize(self.leaf_size));
@@ -233,6 +244,40 @@ pub enum BuildError {
 ///
 /// `progress`, when given, is advanced by the number of triangles placed in leaves, up to
 /// `mesh.faces().len()`; another thread may poll it.
+///
+/// # Errors
+///
+/// - Any error of [`BuildOptions::validate`] for the options alone.
+/// - [`BuildError::PlacementOverflow`] if scaling or centring takes a coordinate beyond
+///   the f64 range; [`BuildError::CoordinateOverflow`] if a placed coordinate rounds to
+///   infinity in the stored precision (f32).
+/// - [`BuildError::TooManyElements`] / [`BuildError::TooLarge`] if the mesh or its tree
+///   does not fit the format's 32-bit counts and references.
+/// - [`BuildError::Image`] if the image is larger than this platform can address.
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::build::{build, BuildOptions};
+/// use obbtree::format::ObbtFile;
+/// use obbtree::mesh::TriMesh;
+///
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let cow = TriMesh::load(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cow.obj").as_ref())?;
+/// let tree = build(&cow, &BuildOptions::default(), None)?;
+/// tree.verify()?;
+/// assert_eq!(tree.info().triangles as usize, cow.faces().len());
+///
+/// // On disk, and back.
+/// let path = std::env::temp_dir().join(format!("obbtree-doc-build-{}.obbt", std::process::id()));
+/// tree.write_atomic(&path)?;
+/// let opened = ObbtFile::open(&path)?;
+/// assert_eq!(opened.info().triangles, tree.info().triangles);
+/// drop(opened);
+/// std::fs::remove_file(&path)?;
+/// # Ok(())
+/// # }
+/// ```
 pub fn build(
     mesh: &TriMesh,
     options: &BuildOptions,

@@ -194,7 +194,7 @@ struct Scan {
 
 impl Scan {
     // why: axis numbers in 0..3 on fixed-size arrays. The hottest loop of a build, kept as
-    // written: index-free forms cost 0.2-0.5% of a whole OBB build (callgrind).
+    // written: index-free forms were measurably slower.
     #[allow(clippy::indexing_slicing)]
     #[inline(always)]
     fn of<'a, const COORDS: bool>(
@@ -248,8 +248,8 @@ fn rounded_rows<R: Real>(frame: &Matrix3<f64>) -> [[R; 3]; 3] {
 /// at most 1% of the boxes' size, far less than any box overshoots its triangles, so it
 /// prunes the same; above it (f32 boxes more than about 2,500 of their sizes apart: the
 /// leaves of models 1e6 apart) the frames' error would grow with the offset. At 64, the
-/// leaves of a bunny 4 diagonals away were re-orthonormalised at every test (11% of a
-/// distance query's instructions) for nothing.
+/// leaves of a bunny 4 diagonals away were re-orthonormalised at every test, a
+/// measurable cost, for nothing.
 const FAR: f64 = 1e4;
 
 /// The rows of `axes` made orthonormal in f64 (Gram–Schmidt, the third row as the cross

@@ -15,8 +15,8 @@ pub const SAT_GUARD: f64 = 1e-6;
 pub const OFFSET_ROUNDING: f64 = 64.0 * f64::EPSILON;
 
 /// Alternating projections after the first pair in [`BoxPair::closest_direction_gap`]:
-/// each costs about 40 flops; more steps tighten the bound a little (bunny and sliding
-/// spheres: 2 to 10% fewer pairs per extra step) and cost more than they save.
+/// each costs about 40 flops; more steps tighten the bound a little (a few fewer pairs
+/// per extra step on the benchmark meshes) and cost more than they save.
 const PROJECTION_STEPS: usize = 1;
 /// How near the closest-direction gap must come to the distance of the points it was
 /// taken between (at least the box distance) for the edge-edge axes to be skipped: they
@@ -190,9 +190,8 @@ impl BoxPair {
     /// of cost, stopping after the first if it reaches `enough`:
     ///
     /// - the gaps between their projections on the 6 face axes (tight for boxes side by
-    ///   side; B's three cost 3% of a query between mesh pairs for no pruning, but
-    ///   between concentric spheres, one turned, they save 7% of the pairs and a third of
-    ///   the time with `rel_err` 0.01);
+    ///   side; B's three prune little between mesh pairs, but between concentric
+    ///   spheres, one turned, they save pairs and time with a relative error allowed);
     /// - the gap on the direction between nearly closest points
     ///   ([`BoxPair::closest_direction_gap`]), near the box distance wherever the axis gaps
     ///   fall short of it: up to a factor √3 for boxes diagonal to each other, and without
@@ -201,7 +200,7 @@ impl BoxPair {
     /// Each is lowered by the frame [`BoxPair::slack`], as `disjoint` raises its radii by
     /// it. 0 if the boxes may touch. (The 9 edge-edge axes of the separating-axis test and
     /// the centre-to-box bounds were terms here too: after the second term they pruned
-    /// nothing on the bunny and cost 30% of a distance query's instructions, callgrind.)
+    /// nothing on the bunny and cost a large share of a distance query.)
     #[inline(always)]
     // why: as in `disjoint`, entries indexed by axis numbers in 0..3.
     #[allow(clippy::indexing_slicing)]

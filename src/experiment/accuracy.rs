@@ -36,6 +36,11 @@ pub struct Workload {
 
 /// The sliding spheres (§5.3.1) at 8 separated positions (x from 1.85 to 2.2) and 3
 /// crossing ones (x = 0.5, 1.0, 1.5), both turned at random.
+///
+/// # Errors
+///
+/// [`ExperimentError::Generate`] if the spheres or poses cannot be made (a bug: the
+/// parameters are fixed).
 pub fn spheres(size: Size, seed: u64) -> Result<Workload, ExperimentError> {
     let (stacks, slices) = match size {
         Size::Full => (101, 200),
@@ -215,6 +220,11 @@ const ASKS: [Ask; 8] = [
 
 /// Runs every choice on every scene, one query at a time (the times are the point), each
 /// pose's time the median of `repeat` runs.
+///
+/// # Errors
+///
+/// [`ExperimentError::Build`] if a scene's tree cannot be built, and
+/// [`ExperimentError::Query`] if a query fails.
 pub fn run(scenes: &[Workload], repeat: u32) -> Result<Vec<Trade>, ExperimentError> {
     let mut trades = Vec::new();
     for scene in scenes {

@@ -355,6 +355,22 @@ pub fn of_variant(points: &[Point], bv: BvKind, variant: Variant) -> Vec<Point> 
 
 /// Runs `query` `repeat` times (at least once): its last answer, and the median time of
 /// one run in seconds.
+///
+/// # Errors
+///
+/// The first error `query` returns; the runs stop there.
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::experiment::median_time;
+///
+/// let (answer, seconds) = median_time(5, || Ok::<_, String>(6 * 7))?;
+/// assert_eq!(answer, 42);
+/// assert!(seconds >= 0.0);
+/// assert_eq!(median_time(5, || Err::<u32, _>("no")), Err("no"));
+/// # Ok::<(), String>(())
+/// ```
 pub fn median_time<T, E>(
     repeat: u32,
     mut query: impl FnMut() -> Result<T, E>,

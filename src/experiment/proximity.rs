@@ -21,6 +21,13 @@ use nalgebra::Vector3;
 /// The ideal spheres never meet, but their polyhedra do once the gap is below the depth
 /// of a facet under the sphere (about 1e-4 at 40,000 triangles): the smallest gaps count
 /// contacts too.
+///
+/// # Errors
+///
+/// [`ExperimentError::Generate`] or [`ExperimentError::Build`] if a sphere or its tree
+/// cannot be made, [`ExperimentError::Query`] if a query fails, and
+/// [`ExperimentError::Levels`] if a tree's levels cannot be measured (none happens with
+/// the experiment's own parameters: these errors are bugs).
 pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, slices, per_decade, decades, queries): (u32, u32, i32, i32, u32) = match size {
         Size::Full => (101, 200, 4, 9, 100),

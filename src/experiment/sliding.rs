@@ -22,6 +22,12 @@ pub const VARIANTS: [(BvKind, Variant); 2] = [
 
 /// Runs the experiment: 40,000-triangle spheres and 1,001 positions at full size;
 /// 1,600-triangle spheres and 101 positions quick. `seed` draws the orientations.
+///
+/// # Errors
+///
+/// [`ExperimentError::Generate`] or [`ExperimentError::Build`] if a sphere or its tree
+/// cannot be made, and [`ExperimentError::Query`] if a query fails (none happens with
+/// the experiment's own parameters: these errors are bugs).
 pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, slices, steps) = match size {
         Size::Full => (101, 200, 1000u32),

@@ -22,6 +22,12 @@ const FIT_FROM: f64 = 500.0;
 /// Runs the experiment: spheres of 80 to about 600,000 triangles (stacks 5 to 388, twice
 /// as many slices) with 1,000 queries each at full size (200 from 100,000 triangles);
 /// 80 to 6,240 triangles with 20 queries quick. `seed` draws the orientations.
+///
+/// # Errors
+///
+/// [`ExperimentError::Generate`] or [`ExperimentError::Build`] if a sphere or its tree
+/// cannot be made, and [`ExperimentError::Query`] if a query fails (none happens with
+/// the experiment's own parameters: these errors are bugs).
 pub fn run(size: Size, seed: u64, progress: Option<&Progress>) -> Result<Outcome, ExperimentError> {
     let (stacks, queries): (&[u32], u32) = match size {
         Size::Full => (

@@ -49,7 +49,7 @@ type Eigenpairs = ([f64; 3], [V3; 3]);
 
 /// Closed-form eigen-decomposition of a symmetric 3×3 matrix scaled to entries ≤ 1.
 ///
-/// About four times faster than the iterative solver, which matters because every
+/// Several times faster than the iterative solver, which matters because every
 /// internal node of a tree build needs one. Stability comes from the order of work:
 /// 1. the eigenvalue farthest from the other two, by the trigonometric formula for the
 ///    roots of the characteristic cubic (the sign of the cubic's invariant tells which end

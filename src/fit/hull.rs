@@ -111,16 +111,35 @@ impl std::error::Error for HullError {}
 /// allowed).
 ///
 /// The result is exact up to a small multiple of [`HULL_TOLERANCE`]: every point lies
-/// inside every face plane or within a few `HULL_TOLERANCE × diameter` of it (at most
-/// ~35× in stress tests of nearly degenerate input, typically under 1×), and hull
-/// vertices are input points. A polyhedron is a closed, consistently oriented, convex
+/// inside every face plane or within a few `HULL_TOLERANCE × diameter` of it (typically
+/// under one, more only on nearly degenerate input), and hull vertices are input points. A polyhedron is a closed, consistently oriented, convex
 /// triangulated surface. Never panics, and runs in `O(n log n)` expected time.
 ///
 /// Floating point can defeat the construction on nearly degenerate input (points within
 /// about the tolerance of a common plane, in ways that fold the surface); that is
 /// detected and reported as [`HullError::Numerical`], never returned as a wrong hull. It
-/// is rare: no node of the shared test meshes but one in fandisk's tree hits it, and about
-/// 0.3 % of adversarial random sets do.
+/// is rare: no node of the shared test meshes but one in fandisk's tree hits it, and only
+/// a small fraction of adversarial random sets do.
+///
+/// # Errors
+///
+/// - [`HullError::Empty`] for no points.
+/// - [`HullError::TooManyPoints`] for more points than `u32` indices address.
+/// - [`HullError::Numerical`] when rounding defeats the construction on nearly
+///   degenerate input (detected, never a wrong hull).
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::fit::hull::{convex_hull, ConvexHull, HullError};
+///
+/// // A tetrahedron and a point inside it: the hull is the tetrahedron.
+/// let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.1, 0.1, 0.1]];
+/// let hull = convex_hull(&points)?;
+/// assert!(matches!(&hull, ConvexHull::Polyhedron { triangles } if triangles.len() == 4));
+/// assert_eq!(convex_hull(&[]), Err(HullError::Empty));
+/// # Ok::<(), HullError>(())
+/// ```
 pub fn convex_hull(points: &[[f64; 3]]) -> Result<ConvexHull, HullError> {
     let Some(&first) = points.first() else {
         return Err(HullError::Empty);

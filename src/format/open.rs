@@ -193,6 +193,24 @@ impl ObbtFile {
     ///
     /// This is the one place obbtree maps files. The map is read-only and private to this
     /// value; every later read goes through checked slices of it.
+    ///
+    /// # Errors
+    ///
+    /// - [`OpenError::Io`] if the file cannot be opened or mapped, or is a directory or
+    ///   another non-regular file.
+    /// - [`OpenError::Format`] with the [`FormatError`] of the header and directory checks
+    ///   (those of [`ObbtFile::from_aligned`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::format::{ObbtFile, OpenError};
+    ///
+    /// let table = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+    /// assert!(table.info().triangles > 0);
+    /// assert!(matches!(ObbtFile::open("no/such/file.obbt"), Err(OpenError::Io { .. })));
+    /// # Ok::<(), OpenError>(())
+    /// ```
     pub fn open(path: impl AsRef<Path>) -> Result<ObbtFile, OpenError> {
         let path = path.as_ref();
         let io = |source| OpenError::Io {
@@ -235,6 +253,30 @@ impl ObbtFile {
 
     /// Takes an in-memory image (for example a copy of an embedded asset) and checks its
     /// header and directory (O(1)).
+    ///
+    /// # Errors
+    ///
+    /// - [`FormatError::TooShort`], [`FormatError::BadSignature`],
+    ///   [`FormatError::UnsupportedVersion`], [`FormatError::HeaderChecksum`],
+    ///   [`FormatError::LengthMismatch`], [`FormatError::HeaderField`],
+    ///   [`FormatError::Section`] or [`FormatError::MissingSection`] for the first header or
+    ///   directory check that fails.
+    /// - [`FormatError::BigEndianHost`] on a big-endian host.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::format::{AlignedBytes, FormatError, ObbtFile};
+    ///
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+    /// let table = ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes))?;
+    /// table.verify()?;
+    /// let cut = ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes[..100]));
+    /// assert!(matches!(cut, Err(FormatError::TooShort { .. })));
+    /// # Ok(())
+    /// # }
+    /// ```
     pub fn from_aligned(bytes: AlignedBytes) -> Result<ObbtFile, FormatError> {
         ObbtFile::from_backing(Backing::Owned(bytes))
     }
@@ -277,6 +319,18 @@ impl ObbtFile {
 
     /// What the header says about the tree, with the placement decoded on open (reads no
     /// section).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::format::ObbtFile;
+    ///
+    /// let table = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+    /// let info = table.info();
+    /// println!("{} {} tree: {} triangles, {} nodes", info.bv.name(), info.precision.name(), info.triangles, info.nodes);
+    /// assert_eq!(info.file_bytes, table.bytes().len() as u64);
+    /// # Ok::<(), obbtree::format::OpenError>(())
+    /// ```
     pub fn info(&self) -> Info {
         self.meta.info.clone()
     }
@@ -284,12 +338,41 @@ impl ObbtFile {
     /// The O(n) checks of the spec: section checksums, zero padding, indices in bounds, a
     /// well-formed tree, finite values, a placement with a finite scale above 0, and every
     /// volume containing the vertices below it.
+    ///
+    /// # Errors
+    ///
+    /// The first problem found, as a [`VerifyError`] naming the region (a section,
+    /// `padding`, `header`, ...) and what is wrong there.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::format::{AlignedBytes, ObbtFile};
+    ///
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let table = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+    /// table.verify()?;
+    ///
+    /// // One flipped byte in a section: the O(1) open checks pass, verify does not.
+    /// let mut bytes = table.bytes().to_vec();
+    /// let section = table.sections().iter().rev().find(|s| s.length > 0).expect("a section");
+    /// bytes[section.offset as usize] ^= 0x55;
+    /// let damaged = ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes))?;
+    /// assert!(damaged.verify().is_err());
+    /// # Ok(())
+    /// # }
+    /// ```
     pub fn verify(&self) -> Result<(), VerifyError> {
         super::verify::verify(self)
     }
 
     /// The tree's volumes measured level by level, root first ([`LevelStats`]). Reads every
     /// node; a damaged, unverified file gives the first defect met.
+    ///
+    /// # Errors
+    ///
+    /// A [`VerifyError`] in region `section nodes` for the first malformed node met (a
+    /// reference out of bounds, a cycle, ...), or if the file's volume type cannot be viewed.
     pub fn level_stats(&self) -> Result<Vec<LevelStats>, VerifyError> {
         struct Levels;
         impl TreeVisitor for Levels {
@@ -306,11 +389,37 @@ impl ObbtFile {
 
     /// Writes the image to `path` atomically (temporary file in the same directory, fsync,
     /// rename): readers see the old file or the new one, never a partial one.
+    ///
+    /// # Errors
+    ///
+    /// The [`std::io::Error`] of creating, writing, syncing or renaming the temporary file
+    /// (the temporary is removed on failure); see [`write_atomic`](super::write_atomic).
     pub fn write_atomic(&self, path: impl AsRef<Path>) -> std::io::Result<()> {
         super::write::write_atomic(path.as_ref(), self.bytes())
     }
 
     /// The tree typed as volume `B`; an error if the file stores another type or precision.
+    ///
+    /// # Errors
+    ///
+    /// - [`FormatError::WrongType`] if the file stores another volume type or precision
+    ///   ([`ObbtFile::visit`] takes whichever it stores).
+    /// - [`FormatError::Section`] if a required section cannot be viewed as records.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::bv::{Obb, Sphere};
+    /// use obbtree::format::{FormatError, ObbtFile};
+    ///
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let table = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?; // an OBB f32 tree
+    /// let tree = table.view::<Obb<f32>>()?;
+    /// assert_eq!(tree.faces().len() as u32, table.info().triangles);
+    /// assert!(matches!(table.view::<Sphere<f64>>(), Err(FormatError::WrongType { .. })));
+    /// # Ok(())
+    /// # }
+    /// ```
     pub fn view<B: BoundingVolume>(&self) -> Result<TreeView<'_, B>, FormatError> {
         let (bv, precision) = (self.bv_kind(), self.precision());
         if B::KIND != bv || <B::Real as Real>::PRECISION != precision {
@@ -354,6 +463,34 @@ impl ObbtFile {
     }
 
     /// Runs `visitor` on the tree with its concrete volume type and precision.
+    ///
+    /// # Errors
+    ///
+    /// The [`FormatError`] of [`ObbtFile::view`] for the stored type (a required section
+    /// that cannot be viewed as records); the visitor's own result is its `Output`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::bv::BoundingVolume;
+    /// use obbtree::format::{ObbtFile, TreeVisitor};
+    /// use obbtree::tree::TreeView;
+    ///
+    /// /// Counts the nodes, whatever the volume type.
+    /// struct NodeCount;
+    /// impl TreeVisitor for NodeCount {
+    ///     type Output = usize;
+    ///     fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> usize {
+    ///         tree.nodes().len()
+    ///     }
+    /// }
+    ///
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let table = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+    /// assert_eq!(table.visit(NodeCount)? as u32, table.info().nodes);
+    /// # Ok(())
+    /// # }
+    /// ```
     pub fn visit<V: TreeVisitor>(&self, visitor: V) -> Result<V::Output, FormatError> {
         /// The file's view typed by [`dispatch`], handed to the tree visitor.
         struct Typed<'f, V> {

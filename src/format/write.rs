@@ -371,6 +371,11 @@ fn split(path: &Path) -> (PathBuf, String) {
 /// Only files named as [`write_atomic`] names them for `path` are considered, and only on
 /// systems where a process's liveness can be checked (Linux, through `/proc`); elsewhere
 /// nothing is removed.
+///
+/// # Errors
+///
+/// The [`std::io::Error`] of listing `path`'s directory (for example, it does not exist).
+/// A stale temporary that cannot be removed is skipped, not an error.
 pub fn remove_stale_temporaries(path: &Path) -> std::io::Result<usize> {
     let proc_dir = Path::new("/proc/self");
     if !proc_dir.exists() {
@@ -412,6 +417,24 @@ pub fn remove_stale_temporaries(path: &Path) -> std::io::Result<usize> {
 /// disk, then renamed over `path`, then the directory flushed. On any error the temporary
 /// file is removed and `path` is untouched; after [`abandon_writes`] it fails with
 /// [`std::io::ErrorKind::Interrupted`], also leaving `path` untouched.
+///
+/// # Errors
+///
+/// The [`std::io::Error`] of creating, writing, syncing or renaming the temporary file
+/// (for example, the directory does not exist or is not writable), or
+/// [`std::io::ErrorKind::Interrupted`] after [`abandon_writes`].
+///
+/// # Examples
+///
+/// ```
+/// let path = std::env::temp_dir().join(format!("obbtree-doc-write-{}.txt", std::process::id()));
+/// obbtree::format::write_atomic(&path, b"old")?;
+/// obbtree::format::write_atomic(&path, b"new")?;
+/// assert_eq!(std::fs::read(&path)?, b"new");
+/// std::fs::remove_file(&path)?;
+/// assert!(obbtree::format::write_atomic("no/such/dir/file".as_ref(), b"x").is_err());
+/// # Ok::<(), std::io::Error>(())
+/// ```
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let (dir, name) = split(path);
     static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);

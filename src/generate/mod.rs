@@ -2,6 +2,32 @@
 //! dissertation's chapter 5, pose sweeps and random poses, and the one seeded generator
 //! they (and the tests) draw from. `obbtree mesh` and `obbtree poses` are these functions
 //! on the command line.
+//!
+//! ```
+//! use obbtree::build::{build, BuildOptions};
+//! use obbtree::generate::{lat_long_sphere, random_poses, sweep, Axis, Sweep, SweepRotation};
+//! use obbtree::query::{CollideOptions, PairQuery};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! // §5.3.1's sphere, smaller: 2 · 20 · 9 triangles.
+//! let sphere = lat_long_sphere(1.0, 10, 20)?;
+//! assert_eq!(sphere.faces().len(), 360);
+//! let tree = build(&sphere, &BuildOptions::default(), None)?;
+//! let mut pair = PairQuery::new(&tree, &tree)?;
+//!
+//! // B slides along x from 0 to 3 by 0.5: the unit spheres overlap below 2 and are 1 apart at 3.
+//! let poses = sweep(&Sweep { axis: Axis::X, from: 0.0, to: 3.0, step: 0.5, rotation: SweepRotation::Identity, seed: 1 })?;
+//! assert_eq!(poses.len(), 7);
+//! let first = CollideOptions { first_contact: true, ..Default::default() };
+//! let [a, b] = &poses[6];
+//! assert!(!pair.collide(a, b, &first)?.colliding);
+//!
+//! // The same seed draws the same poses.
+//! assert_eq!(random_poses(5, 2.0, 7)?, random_poses(5, 2.0, 7)?);
+//! assert!(random_poses(0, 2.0, 7).is_err());
+//! # Ok(())
+//! # }
+//! ```
 
 mod poses;
 mod rng;

@@ -67,6 +67,16 @@ pub type PosePair = [Pose; 2];
 /// The poses of a sweep: offset `i` is `from + i · step` (computed from `i`, so no error
 /// accumulates), up to `to` plus a millionth of a step (so that 0 … 2 by 0.002 ends at 2
 /// despite rounding). A is at the identity.
+///
+/// # Errors
+///
+/// [`GenerateError::Parameter`] for a `from` or `to` that is not finite, a `step` that is
+/// not finite and greater than 0, or `to` below `from`; [`GenerateError::TooManyPoses`]
+/// beyond [`MAX_POSES`].
+///
+/// # Examples
+///
+/// See the [module example](super).
 pub fn sweep(s: &Sweep) -> Result<Vec<PosePair>, GenerateError> {
     for (name, value) in [("from", s.from), ("to", s.to)] {
         if !value.is_finite() {
@@ -115,6 +125,16 @@ pub fn sweep(s: &Sweep) -> Result<Vec<PosePair>, GenerateError> {
 
 /// `count` poses of B: a uniformly random rotation and a translation uniform in the ball
 /// of `radius` about A's origin, drawn in order from `seed`. A is at the identity.
+///
+/// # Errors
+///
+/// [`GenerateError::Count`] for a `count` of 0, [`GenerateError::TooManyPoses`] beyond
+/// [`MAX_POSES`], and [`GenerateError::Parameter`] for a radius that is not finite and at
+/// least 0.
+///
+/// # Examples
+///
+/// See the [module example](super).
 pub fn random_poses(count: u64, radius: f64, seed: u64) -> Result<Vec<PosePair>, GenerateError> {
     if count == 0 {
         return Err(GenerateError::Count {

@@ -10,6 +10,16 @@ use std::f64::consts::{PI, TAU};
 /// two triangles per cell between, `2 · slices · (stacks − 1)` triangles in all, wound
 /// outward. The poles lie on the z axis. §5.3.1's spheres of 40,000 triangles are 101
 /// stacks of 200 slices.
+///
+/// # Errors
+///
+/// [`GenerateError::Parameter`] for a radius that is not finite and greater than 0,
+/// [`GenerateError::Count`] for fewer than 2 stacks or 3 slices, and
+/// [`GenerateError::TooManyTriangles`] beyond [`MAX_GENERATED_TRIANGLES`].
+///
+/// # Examples
+///
+/// See the [module example](super).
 pub fn lat_long_sphere(radius: f64, stacks: u32, slices: u32) -> Result<TriMesh, GenerateError> {
     positive("radius", radius)?;
     at_least("stacks", stacks, 2)?;
@@ -48,6 +58,20 @@ pub fn lat_long_sphere(radius: f64, stacks: u32, slices: u32) -> Result<TriMesh,
 
 /// A flat plate in the z = 0 plane, `size[0]` by `size[1]` and centred on the origin, cut
 /// into `cells[0]` by `cells[1]` squares of two triangles each (normals along +z).
+///
+/// # Errors
+///
+/// [`GenerateError::Parameter`] for a size that is not finite and greater than 0,
+/// [`GenerateError::Count`] for no cells along an axis, and
+/// [`GenerateError::TooManyTriangles`] beyond [`MAX_GENERATED_TRIANGLES`].
+///
+/// # Examples
+///
+/// ```
+/// let plate = obbtree::generate::plate([2.0, 1.0], [4, 2])?;
+/// assert_eq!(plate.faces().len(), 16);
+/// # Ok::<(), obbtree::generate::GenerateError>(())
+/// ```
 pub fn plate(size: [f64; 2], cells: [u32; 2]) -> Result<TriMesh, GenerateError> {
     positive("width", size[0])?;
     positive("height", size[1])?;
@@ -79,6 +103,20 @@ pub fn plate(size: [f64; 2], cells: [u32; 2]) -> Result<TriMesh, GenerateError> 
 /// The axis-aligned box with half-widths `half` (each at least 0) centred at `center`: 8
 /// corners, 12 triangles wound outward. Corner `i` has the upper coordinate on axis `k`
 /// when bit `k` of `i` is set.
+///
+/// # Errors
+///
+/// [`GenerateError::Parameter`] for a half-width that is not finite and at least 0, or a
+/// centre coordinate that is not finite (or whose corners would not be).
+///
+/// # Examples
+///
+/// ```
+/// let cube = obbtree::generate::cuboid([0.5; 3], [0.0, 0.0, 1.0])?;
+/// assert_eq!((cube.vertices().len(), cube.faces().len()), (8, 12));
+/// assert_eq!(cube.vertices()[7], [0.5, 0.5, 1.5]);
+/// # Ok::<(), obbtree::generate::GenerateError>(())
+/// ```
 pub fn cuboid(half: [f64; 3], center: [f64; 3]) -> Result<TriMesh, GenerateError> {
     for (name, h) in ["half-width x", "half-width y", "half-width z"]
         .into_iter()

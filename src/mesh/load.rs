@@ -17,6 +17,25 @@ impl TriMesh {
     /// a binary STL by its size rule, an ASCII STL by its leading `solid`, an
     /// OBJ by a `v` statement; anything else is [`MeshError::UnknownFormat`].
     /// Errors name the path as given.
+    ///
+    /// # Errors
+    ///
+    /// - [`MeshError::Io`] if the file cannot be read.
+    /// - [`MeshError::UnknownFormat`] if neither the extension nor the content
+    ///   says OBJ or STL.
+    /// - Any error of [`TriMesh::from_obj_bytes`] or [`TriMesh::from_stl_bytes`]
+    ///   for the content.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::mesh::TriMesh;
+    ///
+    /// let cow = TriMesh::load(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cow.obj").as_ref())?;
+    /// assert!(cow.faces().len() > 1000);
+    /// assert!(TriMesh::load("no/such/file.obj".as_ref()).is_err());
+    /// # Ok::<(), obbtree::mesh::MeshError>(())
+    /// ```
     pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
         let file = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
@@ -50,6 +69,27 @@ impl TriMesh {
 
     /// Parses Wavefront OBJ text (all objects and groups merged in file order,
     /// polygons fan-triangulated); `name` is the input name used in errors.
+    ///
+    /// # Errors
+    ///
+    /// - [`MeshError::Syntax`] for a malformed statement or token (with its line).
+    /// - [`MeshError::IndexOutOfRange`] for a face index with no such vertex.
+    /// - [`MeshError::NonFinite`] for a NaN, infinite or overflowing coordinate.
+    /// - [`MeshError::EmptyMesh`] / [`MeshError::NoFaces`] for no vertices / no faces.
+    /// - [`MeshError::TooLarge`] above [`MAX_VERTICES`](super::MAX_VERTICES) or
+    ///   [`MAX_TRIANGLES`](super::MAX_TRIANGLES).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::mesh::{MeshError, TriMesh};
+    ///
+    /// let quad = TriMesh::from_obj_bytes(b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", "quad")?;
+    /// assert_eq!(quad.faces().len(), 2); // fan-triangulated
+    /// let bad = TriMesh::from_obj_bytes(b"v 0 0 0\nf 1 2 3\n", "bad");
+    /// assert!(matches!(bad, Err(MeshError::IndexOutOfRange { .. })));
+    /// # Ok::<(), MeshError>(())
+    /// ```
     pub fn from_obj_bytes(bytes: &[u8], name: &str) -> Result<TriMesh, MeshError> {
         obj::parse(bytes, name)
     }
@@ -57,6 +97,28 @@ impl TriMesh {
     /// Parses a binary or ASCII STL (detected from the content) with
     /// bitwise-identical positions merged into shared vertices; `name` is the
     /// input name used in errors.
+    ///
+    /// # Errors
+    ///
+    /// - [`MeshError::BinaryStlLength`] for a binary STL whose length disagrees with
+    ///   its triangle count.
+    /// - [`MeshError::Syntax`] for a malformed ASCII STL statement (with its line).
+    /// - [`MeshError::NonFinite`] for a NaN or infinite coordinate.
+    /// - [`MeshError::EmptyMesh`] for no triangles.
+    /// - [`MeshError::TooLarge`] above [`MAX_VERTICES`](super::MAX_VERTICES) or
+    ///   [`MAX_TRIANGLES`](super::MAX_TRIANGLES).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::mesh::TriMesh;
+    ///
+    /// let stl = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n\
+    ///             vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+    /// let triangle = TriMesh::from_stl_bytes(stl, "triangle.stl")?;
+    /// assert_eq!((triangle.vertices().len(), triangle.faces().len()), (3, 1));
+    /// # Ok::<(), obbtree::mesh::MeshError>(())
+    /// ```
     pub fn from_stl_bytes(bytes: &[u8], name: &str) -> Result<TriMesh, MeshError> {
         stl::parse(bytes, name)
     }

@@ -43,6 +43,25 @@ impl TriMesh {
     /// face, at most [`MAX_VERTICES`] / [`MAX_TRIANGLES`], every index
     /// `< vertices.len()`, every coordinate finite. Errors name `<memory>` and
     /// the 0-based vertex or face id at fault.
+    ///
+    /// # Errors
+    ///
+    /// - [`MeshError::EmptyMesh`] / [`MeshError::NoFaces`] for no vertices / no faces.
+    /// - [`MeshError::TooLarge`] above [`MAX_VERTICES`] or [`MAX_TRIANGLES`].
+    /// - [`MeshError::NonFinite`] for a NaN or infinite coordinate.
+    /// - [`MeshError::IndexOutOfRange`] for an index `>= vertices.len()`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::mesh::{MeshError, TriMesh};
+    ///
+    /// let triangle = TriMesh::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], vec![[0, 1, 2]])?;
+    /// assert_eq!(triangle.faces(), &[[0, 1, 2]]);
+    /// let dangling = TriMesh::new(vec![[0.0; 3]], vec![[0, 1, 2]]);
+    /// assert!(matches!(dangling, Err(MeshError::IndexOutOfRange { .. })));
+    /// # Ok::<(), MeshError>(())
+    /// ```
     pub fn new(vertices: Vec<[f64; 3]>, faces: Vec<[u32; 3]>) -> Result<TriMesh, MeshError> {
         TriMesh::validated(MEMORY, vertices, faces)
     }

@@ -11,12 +11,12 @@
 //! its options and returning its answer with the [`Work`] it did. [`details`] holds the
 //! same queries as generic functions over typed tree views.
 //!
-//! ```no_run
+//! ```
 //! use obbtree::format::ObbtFile;
 //! use obbtree::query::{CollideOptions, PairQuery, Pose};
 //!
-//! let a = ObbtFile::open("bunny.obbt")?;
-//! let b = ObbtFile::open("cow.obbt")?;
+//! let a = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+//! let b = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/cow.obbt"))?;
 //! let mut pair = PairQuery::new(&a, &b)?;
 //! let at = Pose::translation(0.1, 0.0, 0.0);
 //! let result = pair.collide(&Pose::identity(), &at, &CollideOptions::default())?;

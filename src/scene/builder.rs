@@ -88,6 +88,36 @@ impl SceneBuilder {
     }
 
     /// Checks the description and builds the scene at its start poses.
+    ///
+    /// # Errors
+    ///
+    /// A [`SceneError`] with origin `scene`, naming the object or rule and field at fault:
+    /// an object or group name that is empty or not made of ASCII letters, digits, `_`,
+    /// `.` and `-`; an object name used twice; assets of different volume types or
+    /// precisions; a rule whose selector names no object or group; or an effect with a
+    /// clearance, relative error or maximum distance out of range.
+    ///
+    /// # Examples
+    ///
+    /// See the [module example](super) for a scene built and stepped. A rule about an
+    /// object that does not exist is refused:
+    ///
+    /// ```
+    /// use obbtree::format::ObbtFile;
+    /// use obbtree::query::Pose;
+    /// use obbtree::scene::{Effect, SceneBuilder};
+    /// use std::sync::Arc;
+    ///
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let table = Arc::new(ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?);
+    /// let mut scene = SceneBuilder::new();
+    /// scene.object("table", table, &[], Pose::identity());
+    /// scene.rule("table", "chair", Effect::Contact);
+    /// let error = scene.build().unwrap_err();
+    /// assert_eq!(error.origin, "scene");
+    /// # Ok(())
+    /// # }
+    /// ```
     pub fn build(self) -> Result<Scene, SceneError> {
         self.checked().map_err(|p| p.located("scene", None))
     }

@@ -99,6 +99,38 @@ pub struct LoadedScene {
 /// Reads a scene file: objects, their assets (each file opened or built once, shared by
 /// every object that names it), and rules. Every error names the file, the line and the
 /// field.
+///
+/// # Errors
+///
+/// A [`SceneError`] with `origin` the file (or, for an asset, the asset's path), the line
+/// and the field when known, and the cause as its `source` when there is one:
+///
+/// - the scene file cannot be read, is not valid TOML, or has an unknown or ill-typed
+///   field;
+/// - a pose is not valid in the file's pose format ([`PoseFormat::parse`]);
+/// - an asset cannot be opened ([`OpenError`](crate::format::OpenError)), loaded
+///   ([`MeshError`](crate::mesh::MeshError)) or built ([`BuildError`](crate::build::BuildError));
+/// - the objects and rules fail the checks of [`SceneBuilder::build`](super::SceneBuilder::build).
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::scene::{load, FrameReader};
+/// use std::io::BufReader;
+///
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let loaded = load(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/cell.toml").as_ref())?;
+/// let frames = loaded.frames.as_ref().expect("cell.toml names its frames");
+/// let mut scene = loaded.scene;
+/// let input = BufReader::new(std::fs::File::open(frames)?);
+/// let mut reader = FrameReader::new(input, "cell.jsonl", &scene, loaded.pose_format, loaded.orthonormalize);
+/// for frame in reader.by_ref().take(10) {
+///     scene.step(&frame?)?;
+/// }
+/// assert_eq!(scene.summary().frames, 10);
+/// # Ok(())
+/// # }
+/// ```
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
     let source = path.display().to_string();
     let fail = |m: String| SceneError::new(&source, m);

@@ -70,6 +70,12 @@ impl<R: BufRead> FrameReader<R> {
     }
 
     /// The next frame, `None` at the end of the input.
+    ///
+    /// # Errors
+    ///
+    /// `Some(Err)` with a [`SceneError`] naming the source and line (and the object for a
+    /// pose): the input cannot be read, a line is empty or not a JSON frame, a frame names
+    /// an unknown object, or a pose is not valid in the format ([`PoseFormat::parse`]).
     pub fn next_frame(&mut self) -> Option<Result<Frame, SceneError>> {
         self.buffer.clear();
         let read = (&mut self.input)

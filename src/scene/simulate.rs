@@ -104,6 +104,36 @@ impl Scene {
     }
 
     /// Moves the objects of `frame` (others keep their poses) and answers every pair.
+    ///
+    /// # Errors
+    ///
+    /// A [`SceneError`] with origin `frame` if the frame names an object id the scene does
+    /// not have, or with origin `scene` naming the two objects if a pair's query fails (its
+    /// [`QueryError`](crate::query::QueryError) is the `source`).
+    ///
+    /// # Examples
+    ///
+    /// See the [module example](super) and [`load`](super::load).
+    ///
+    /// ```
+    /// use obbtree::format::ObbtFile;
+    /// use obbtree::query::Pose;
+    /// use obbtree::scene::{Effect, Frame, SceneBuilder};
+    /// use std::sync::Arc;
+    ///
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let table = Arc::new(ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?);
+    /// let mut scene = SceneBuilder::new();
+    /// let a = scene.object("a", table.clone(), &["furniture"], Pose::identity());
+    /// let b = scene.object("b", table, &["furniture"], Pose::translation(10.0, 0.0, 0.0));
+    /// scene.rule("furniture", "furniture", Effect::Contact);
+    /// let mut scene = scene.build()?;
+    /// assert!(scene.step(&Frame::new())?.pairs.is_empty());
+    /// assert!(!scene.step(Frame::new().set(b, Pose::identity()))?.pairs.is_empty());
+    /// assert!(scene.step(Frame::new().set(a + 2, Pose::identity())).is_err()); // no such object
+    /// # Ok(())
+    /// # }
+    /// ```
     pub fn step(&mut self, frame: &Frame) -> Result<&FrameReport, SceneError> {
         let started = Instant::now();
         let number = self.schedule.begin_frame();
