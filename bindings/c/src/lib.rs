@@ -1385,33 +1385,22 @@ pub unsafe extern "C" fn obbtree_distance_batch(
     results: *mut ObbtreeDistanceResult,
     results_len: usize,
 ) -> ObbtreeStatus {
-    guard(|| {
-        // SAFETY: NULL or `results_len` writable results (the caller's contract).
-        let results = unsafe { slots(results, results_len, "results") }?;
-        // SAFETY: forwarded from the caller's contract.
-        let batch = unsafe {
-            Batch::new(
-                a,
-                poses_a,
-                count_a,
-                b,
-                poses_b,
-                count_b,
-                threads,
-                results_len,
-            )
-        }?;
-        let options = distance_options(rel_err, abs_err, max_distance);
-        let answers = batch.run(|pair, pa, pb| pair.distance(pa, pb, &options))?;
-        for (slot, answer) in results.iter_mut().zip(&answers) {
-            slot.write(ObbtreeDistanceResult {
+    let options = distance_options(rel_err, abs_err, max_distance);
+    // SAFETY: forwarded from the caller's contract.
+    unsafe {
+        one_record_per_pose(
+            (a, poses_a, count_a),
+            (b, poses_b, count_b),
+            threads,
+            (results, results_len),
+            |pair, pa, pb| pair.distance(pa, pb, &options),
+            |answer| ObbtreeDistanceResult {
                 found: answer.closest.is_some(),
                 closest: witness(answer.closest.as_ref()),
                 work: work(&answer.work),
-            });
-        }
-        Ok(())
-    })
+            },
+        )
+    }
 }
 
 /// `obbtree_pair_within` for a batch of poses, in parallel; the poses, counts, `threads`
@@ -1436,33 +1425,21 @@ pub unsafe extern "C" fn obbtree_within_batch(
     results: *mut ObbtreeToleranceResult,
     results_len: usize,
 ) -> ObbtreeStatus {
-    guard(|| {
-        // SAFETY: NULL or `results_len` writable results (the caller's contract).
-        let results = unsafe { slots(results, results_len, "results") }?;
-        // SAFETY: forwarded from the caller's contract.
-        let batch = unsafe {
-            Batch::new(
-                a,
-                poses_a,
-                count_a,
-                b,
-                poses_b,
-                count_b,
-                threads,
-                results_len,
-            )
-        }?;
-        let options = ToleranceOptions::new(tolerance);
-        let answers = batch.run(|pair, pa, pb| pair.within(pa, pb, &options))?;
-        for (slot, answer) in results.iter_mut().zip(&answers) {
-            slot.write(ObbtreeToleranceResult {
+    // SAFETY: forwarded from the caller's contract.
+    unsafe {
+        one_record_per_pose(
+            (a, poses_a, count_a),
+            (b, poses_b, count_b),
+            threads,
+            (results, results_len),
+            |pair, pa, pb| pair.within(pa, pb, &ToleranceOptions::new(tolerance)),
+            |answer| ObbtreeToleranceResult {
                 closer: answer.witness.is_some(),
                 witness: witness(answer.witness.as_ref()),
                 work: work(&answer.work),
-            });
-        }
-        Ok(())
-    })
+            },
+        )
+    }
 }
 
 /// `obbtree_pair_span` for a batch of poses, in parallel; the poses, counts, `threads`
@@ -1486,6 +1463,39 @@ pub unsafe extern "C" fn obbtree_span_batch(
     results: *mut ObbtreeSpanResult,
     results_len: usize,
 ) -> ObbtreeStatus {
+    // SAFETY: forwarded from the caller's contract.
+    unsafe {
+        one_record_per_pose(
+            (a, poses_a, count_a),
+            (b, poses_b, count_b),
+            threads,
+            (results, results_len),
+            |pair, pa, pb| pair.span(pa, pb, &SpanOptions::default()),
+            |answer| ObbtreeSpanResult {
+                farthest: witness(Some(&answer.farthest)),
+                work: work(&answer.work),
+            },
+        )
+    }
+}
+
+/// The batched queries whose answer is one record per pose (distance, within, span): the
+/// output checked, the batch read, `query` run on every pose pair in parallel, and each
+/// answer written through `record`.
+///
+/// # Safety
+///
+/// As the batch entry points: the trees NULL or open, each pose pointer NULL or pointing
+/// at 12 readable doubles per pose, `results` NULL or pointing at `results_len` writable
+/// records not overlapping the inputs.
+unsafe fn one_record_per_pose<A: Send, R>(
+    (a, poses_a, count_a): (*const ObbtreeTree, *const f64, usize),
+    (b, poses_b, count_b): (*const ObbtreeTree, *const f64, usize),
+    threads: usize,
+    (results, results_len): (*mut R, usize),
+    query: impl Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<A, QueryError> + Sync,
+    record: impl Fn(&A) -> R,
+) -> ObbtreeStatus {
     guard(|| {
         // SAFETY: NULL or `results_len` writable results (the caller's contract).
         let results = unsafe { slots(results, results_len, "results") }?;
@@ -1502,13 +1512,9 @@ pub unsafe extern "C" fn obbtree_span_batch(
                 results_len,
             )
         }?;
-        let options = SpanOptions::default();
-        let answers = batch.run(|pair, pa, pb| pair.span(pa, pb, &options))?;
+        let answers = batch.run(query)?;
         for (slot, answer) in results.iter_mut().zip(&answers) {
-            slot.write(ObbtreeSpanResult {
-                farthest: witness(Some(&answer.farthest)),
-                work: work(&answer.work),
-            });
+            slot.write(record(answer));
         }
         Ok(())
     })
