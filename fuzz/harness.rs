@@ -1,5 +1,5 @@
 //! Fuzz harness logic, shared by the cargo-fuzz targets in `fuzz/fuzz_targets/` and by the
-//! stable test `tests/fuzz_corpus.rs`, which replays the checked-in corpus through it.
+//! stable test `tests/it/fuzz_corpus.rs`, which replays the checked-in corpus through it.
 //!
 //! Depends only on `obbtree`, `crc32fast` and the re-sealing of `tests/common/seal.rs`, which
 //! the mutation suites share (no libFuzzer), so it compiles in both places. Every

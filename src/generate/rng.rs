@@ -5,7 +5,7 @@
 //!
 //! xorshift64 (13, 7, 17) on a seed spread by the golden ratio: plenty for sampling poses
 //! and test inputs, and not for cryptography. Its sequence is pinned by the tests whose
-//! work counts come from its poses (`tests/distance_work.rs`): changing it changes them.
+//! work counts come from its poses (`tests/it/distance_work.rs`): changing it changes them.
 
 use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 

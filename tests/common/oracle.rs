@@ -1,7 +1,7 @@
 //! The brute-force reference of the query suites: every triangle pair of two lists tested
 //! with the library's leaf primitives. A query that prunes a pair it should have opened
 //! then disagrees with it; the primitives themselves are checked against independent
-//! references in `tests/triangle_primitives.rs`.
+//! references in `tests/it/triangle_primitives.rs`.
 //!
 //! Both lists must be in one frame. [`in_frame_of_a`] maps B's triangles as the queries
 //! map them, so that the oracle and a query round alike and can be compared exactly.

@@ -1,6 +1,6 @@
 //! The tests' seeded generator is the library's ([`obbtree::generate::Rng`]): the same
 //! seed gives the same numbers on every machine, so a failing case can be replayed. Its
-//! sequence is pinned by `tests/distance_work.rs`, whose poses come from
+//! sequence is pinned by `tests/it/distance_work.rs`, whose poses come from
 //! [`seeded_rotation`]: changing the generator changes those counts.
 
 use nalgebra::Matrix3;

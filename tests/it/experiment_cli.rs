@@ -9,7 +9,7 @@
     clippy::indexing_slicing
 )]
 
-mod common;
+use crate::common;
 
 use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
 use std::collections::HashMap;

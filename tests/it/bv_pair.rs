@@ -3,7 +3,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
-mod common;
+use crate::common;
 
 use common::oracle;
 use nalgebra::{Matrix3, Rotation3, Vector3};

@@ -16,7 +16,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::expect_used, clippy::panic)]
 
-mod common;
+use crate::common;
 
 use common::mutate::{
     entry_field, entry_offset, exercise, extreme_values, header_field, read_uint, write_uint,

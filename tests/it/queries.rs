@@ -14,7 +14,7 @@
     clippy::unwrap_in_result
 )]
 
-mod common;
+use crate::common;
 
 use common::oracle;
 use nalgebra::{Rotation3, Vector3};

@@ -2,7 +2,7 @@
 //! summary has one right value. A regression to "compute everything" (no culling, no
 //! reuse, no early exit, no warm start) changes them and fails here.
 
-mod common;
+use crate::common;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::query::Pose;

@@ -15,7 +15,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use crate::common;
 
 use common::oracle;
 use nalgebra::{Matrix3, Vector3};

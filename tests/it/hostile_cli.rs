@@ -8,7 +8,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
-mod common;
+use crate::common;
 
 use common::mutate::{
     entry_field, entry_offset, extreme_values, header_field, read_uint, write_uint, ENTRY_FIELDS,

@@ -7,7 +7,7 @@
     clippy::string_slice
 )]
 
-mod common;
+use crate::common;
 
 use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
 use std::path::{Path, PathBuf};

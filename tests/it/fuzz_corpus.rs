@@ -5,7 +5,10 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::panic)]
 
-#[path = "../fuzz/harness.rs"]
+// The harness brings its own copy of `common::seal`: the fuzz crate, where it also
+// compiles, has no `tests/common`.
+#[allow(clippy::duplicate_mod)]
+#[path = "../../fuzz/harness.rs"]
 mod harness;
 
 use std::path::{Path, PathBuf};

@@ -12,7 +12,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::expect_used)]
 
-mod common;
+use crate::common;
 
 use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};

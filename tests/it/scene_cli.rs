@@ -4,7 +4,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
-mod common;
+use crate::common;
 
 use common::cli::{assert_bad_input, obbtree, scratch, stderr, ScratchDir};
 use obbtree::build::{build, BuildOptions};

@@ -5,7 +5,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::indexing_slicing)]
 
-mod common;
+use crate::common;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::query::{DistanceOptions, PairQuery, Pose, Work};

@@ -10,7 +10,7 @@
     clippy::unwrap_in_result
 )]
 
-mod common;
+use crate::common;
 
 use nalgebra::{Rotation3, Unit, Vector3};
 use obbtree::build::{build, BuildOptions};

@@ -4,7 +4,7 @@
 //! in shows here; a deliberate improvement updates them, with the before and after in its
 //! commit message.
 
-mod common;
+use crate::common;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::query::{CollideOptions, PairQuery, Pose};

@@ -2,7 +2,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::panic)]
 
-mod common;
+use crate::common;
 
 use obbtree::tree::{
     Encoding, NodeRef, BINARY_MAX_CHILD, BINARY_MAX_FACE, VARIABLE_MAX_CHILD,

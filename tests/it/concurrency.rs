@@ -3,7 +3,7 @@
 // Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use crate::common;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::format::ObbtFile;

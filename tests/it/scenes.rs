@@ -1,7 +1,7 @@
 //! The dissertation's benchmark scenes at a coarse tessellation, against brute force: the
 //! sliding spheres of §5.3.1 (collision) and the concentric spheres (distance).
 
-mod common;
+use crate::common;
 
 use common::oracle;
 use nalgebra::Vector3;

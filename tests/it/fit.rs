@@ -8,7 +8,7 @@ use obbtree::fit::hull::{convex_hull, ConvexHull, HULL_TOLERANCE};
 use obbtree::fit::{principal_axes, FitMethod};
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 
 use common::rng::Rng;
 

@@ -1,0 +1,35 @@
+//! The integration tests, one module per concern, linked into one binary: one link of the
+//! crate and its dependencies instead of one per suite, and one test run whose threads
+//! share the machine across suites.
+//! Run one module with `cargo test --release --test it MODULE::`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod build_roundtrip;
+mod bv_pair;
+mod cli;
+mod concurrency;
+mod contact_work;
+mod corruption;
+mod distance_work;
+mod doc_links;
+mod encoding;
+mod experiment_cli;
+mod far_apart;
+mod fit;
+mod fuzz_corpus;
+mod hard_cases;
+mod hostile_cli;
+mod hostile_files;
+mod mesh_loaders;
+mod poses;
+mod queries;
+mod scene_broad;
+mod scene_cli;
+mod scene_equivalence;
+mod scene_work;
+mod scenes;
+mod triangle_primitives;
+mod units;
+mod work_pins;
