@@ -4,17 +4,17 @@ use super::build::{build_with_progress, load_mesh, TreeArgs};
 use super::files::is_obbt;
 use super::poses::PoseArgs;
 use super::print::{self, out};
-use super::{number, with_threads, Failure};
+use super::{number, Failure};
 use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
 use obbtree::experiment::median_time;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    BoxTest, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, SpanOptions,
-    ToleranceOptions, Witness, Work,
+    BatchOptions, BoxTest, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose,
+    PoseBatch, SpanOptions, ToleranceOptions, Witness, Work,
 };
-use rayon::prelude::*;
 use serde_json::{json, Value};
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
 /// The two models and their poses, shared by every query command.
@@ -331,19 +331,19 @@ where
             out!("{text}")
         };
     };
-    let run = || -> Vec<Result<Value, Failure>> {
-        batch
-            .par_iter()
-            .map_init(
-                || PairQuery::new(a, b),
-                |pair, (pa, pb)| match pair {
-                    Ok(pair) => query(pa, pb, pair).map(|(v, _)| v),
-                    Err(e) => Err(e.clone().into()),
-                },
-            )
-            .collect()
+    let (poses_a, poses_b): (Vec<Pose>, Vec<Pose>) = batch.into_iter().unzip();
+    let options = BatchOptions {
+        threads: inputs
+            .threads
+            .and_then(|n| NonZeroUsize::new(usize::try_from(n).ok()?)),
     };
-    let answers = with_threads(inputs.threads, run)?;
+    let answers = obbtree::query::batch(
+        a,
+        b,
+        PoseBatch::new(&poses_a, &poses_b)?,
+        &options,
+        |pair, pa, pb| query(pa, pb, pair).map(|(value, _)| value),
+    )?;
     for (index, answer) in answers.into_iter().enumerate() {
         if print::closed() {
             break;

@@ -8,8 +8,9 @@
 //! [`PairQuery`] is the one way in: made once per pair of models, it answers collision
 //! ([`PairQuery::collide`]), distance ([`PairQuery::distance`]), tolerance
 //! ([`PairQuery::within`]) and span ([`PairQuery::span`]), each taking the two poses and
-//! its options and returning its answer with the [`Work`] it did. [`details`] holds the
-//! same queries as generic functions over typed tree views.
+//! its options and returning its answer with the [`Work`] it did. [`batch`] answers many
+//! poses of one pair in parallel. [`details`] holds the same queries as generic functions
+//! over typed tree views.
 //!
 //! ```
 //! use obbtree::format::ObbtFile;
@@ -24,6 +25,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod batch;
 mod collide;
 mod descent;
 pub mod details;
@@ -35,6 +37,7 @@ pub mod triangle;
 mod work;
 
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
+pub use batch::{batch, BatchError, BatchOptions, PoseBatch};
 pub use collide::{BoxTest, CollideOptions, CollideResult};
 pub use descent::DescentRule;
 pub use distance::{

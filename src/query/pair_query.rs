@@ -102,6 +102,12 @@ impl<'f> PairQuery<'f> {
         self.context
     }
 
+    /// The traversal scratch, leaving an empty one (for a holder that cannot move the pair
+    /// out, such as a `Drop`).
+    pub(crate) fn take_context(&mut self) -> QueryContext {
+        std::mem::take(&mut self.context)
+    }
+
     /// Model A.
     pub fn a(&self) -> &'f ObbtFile {
         self.a

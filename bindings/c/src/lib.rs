@@ -31,8 +31,9 @@ use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile, OpenError, VerifyError};
 use obbtree::query::{
-    CollideOptions, CollideResult, DistanceOptions, PairQuery, Pose, PoseError, PoseFormat,
-    QueryError, SpanOptions, ToleranceOptions, Witness, Work,
+    batch, BatchError, BatchOptions, CollideOptions, CollideResult, DistanceOptions, PairQuery,
+    Pose, PoseBatch, PoseError, PoseFormat, QueryError, SpanOptions, ToleranceOptions, Witness,
+    Work,
 };
 use obbtree::real::Precision;
 use obbtree::tree::Encoding;
@@ -40,6 +41,7 @@ use rayon::prelude::*;
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 use std::mem::MaybeUninit;
+use std::num::NonZeroUsize;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{Arc, Mutex, TryLockError};
 
@@ -336,6 +338,18 @@ impl From<QueryError> for Error {
             _ => ObbtreeStatus::CorruptTree,
         };
         Error::new(status, e.to_string())
+    }
+}
+
+impl From<BatchError> for Error {
+    fn from(e: BatchError) -> Error {
+        match e {
+            BatchError::Pair(e) => Error::from(e),
+            BatchError::Threads { ref source, .. } => {
+                Error::new(ObbtreeStatus::InternalError, format!("{e}: {source}"))
+            }
+            other => Error::new(ObbtreeStatus::InternalError, other.to_string()),
+        }
     }
 }
 
@@ -1120,9 +1134,7 @@ struct Batch<'a> {
     b: &'a ObbtFile,
     poses_a: Vec<Pose>,
     poses_b: Vec<Pose>,
-    /// Queries: the larger count (the other side has the same count or 1, broadcast).
-    n: usize,
-    threads: usize,
+    options: BatchOptions,
 }
 
 /// The poses of one side of a batch, each checked; the first bad one is named.
@@ -1163,21 +1175,6 @@ impl<'a> Batch<'a> {
                 "threads is {threads}: at most {OBBTREE_MAX_THREADS} (0 for one per core)"
             )));
         }
-        let n = match (count_a, count_b) {
-            (x, y) if x == y => x,
-            (1, y) => y,
-            (x, 1) => x,
-            (x, y) => {
-                return Err(Error::bad(format!(
-                    "count_a is {x} and count_b is {y}: they must be equal, or one of them 1 (a pose used with every pose of the other side)"
-                )))
-            }
-        };
-        if results_len != n {
-            return Err(Error::bad(format!(
-                "results_len is {results_len} but the batch has {n} queries"
-            )));
-        }
         let numbers = |count: usize, name: &str| {
             count
                 .checked_mul(12)
@@ -1191,52 +1188,40 @@ impl<'a> Batch<'a> {
                 slice(poses_b, len_b, "poses_b")?,
             )
         };
-        // Checked once here: every worker can then make its own pair without failing.
-        PairQuery::new(&a.file, &b.file)?;
-        Ok(Batch {
+        let batch = Batch {
             a: &a.file,
             b: &b.file,
             poses_a: read_poses(values_a, "poses_a")?,
             poses_b: read_poses(values_b, "poses_b")?,
-            n,
-            threads,
+            options: BatchOptions {
+                threads: NonZeroUsize::new(threads),
+            },
+        };
+        let n = batch.poses()?.len();
+        if results_len != n {
+            return Err(Error::bad(format!(
+                "results_len is {results_len} but the batch has {n} queries"
+            )));
+        }
+        Ok(batch)
+    }
+
+    fn poses(&self) -> Result<PoseBatch<'_>, Error> {
+        PoseBatch::new(&self.poses_a, &self.poses_b).map_err(|e| match e {
+            BatchError::Lengths { a, b } => Error::bad(format!(
+                "count_a is {a} and count_b is {b}: they must be equal, or one of them 1 (a pose used with every pose of the other side)"
+            )),
+            other => Error::from(other),
         })
     }
 
-    /// Runs `query` on every pose pair, in parallel (one pair query per worker), and
-    /// returns the answers in pose order, or the error of the first pose that failed.
+    /// Runs `query` on every pose pair, in parallel, and returns the answers in pose
+    /// order, or the error of the first pose that failed.
     fn run<T: Send>(
         &self,
         query: impl Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<T, QueryError> + Sync,
     ) -> Result<Vec<T>, Error> {
-        let pose = |poses: &[Pose], i: usize| poses[if poses.len() == 1 { 0 } else { i }];
-        let run = || -> Vec<Result<T, QueryError>> {
-            (0..self.n)
-                .into_par_iter()
-                .map_init(
-                    || PairQuery::new(self.a, self.b),
-                    |pair, i| match pair {
-                        Ok(pair) => query(pair, &pose(&self.poses_a, i), &pose(&self.poses_b, i)),
-                        Err(e) => Err(e.clone()),
-                    },
-                )
-                .collect()
-        };
-        let answers = if self.threads == 0 {
-            run()
-        } else {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(self.threads)
-                .build()
-                .map_err(|e| {
-                    Error::new(
-                        ObbtreeStatus::InternalError,
-                        format!("could not start {} threads: {e}", self.threads),
-                    )
-                })?
-                .install(run)
-        };
-        answers
+        batch(self.a, self.b, self.poses()?, &self.options, query)?
             .into_iter()
             .enumerate()
             .map(|(i, answer)| {

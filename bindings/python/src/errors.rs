@@ -7,7 +7,7 @@
 use obbtree::build::BuildError;
 use obbtree::format::{FormatError, OpenError};
 use obbtree::mesh::MeshError;
-use obbtree::query::QueryError;
+use obbtree::query::{BatchError, QueryError};
 use obbtree::scene::SceneError;
 use pyo3::exceptions::{PyException, PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -69,6 +69,25 @@ impl From<QueryError> for Failure {
             _ => Kind::Base,
         };
         Failure::new(kind, e.to_string())
+    }
+}
+
+impl From<BatchError> for Failure {
+    fn from(e: BatchError) -> Failure {
+        match e {
+            BatchError::Pair(e) => Failure::from(e),
+            // In the names of the batch functions' arguments.
+            BatchError::Lengths { a, b } => Failure::new(
+                Kind::Pose,
+                format!(
+                    "poses_a holds {a} poses and poses_b {b}: give batches of one length, or one pose to broadcast"
+                ),
+            ),
+            BatchError::Threads { ref source, .. } => {
+                Failure::new(Kind::Base, format!("{e}: {source}"))
+            }
+            other => Failure::new(Kind::Base, other.to_string()),
+        }
     }
 }
 

@@ -9,7 +9,7 @@ use pyo3::types::PyTuple;
 
 /// Poses as given, copied out of Python so that they can be read without the GIL: `count`
 /// poses of `format` (16 numbers of a 4x4 matrix or 12 of R then t), row-major, one after
-/// the other. `single` when one pose was given (it broadcasts against a batch).
+/// the other. `single` when one pose was given rather than a batch.
 pub struct RawPoses {
     /// The argument's name, for errors (`poses_a`).
     pub name: String,

@@ -10,15 +10,14 @@ use crate::tree::Tree;
 use numpy::{PyArray1, PyArrayMethods};
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, QueryContext, QueryError,
-    SpanOptions, ToleranceOptions, Witness, Work,
+    batch, BatchOptions, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, PoseBatch,
+    QueryError, SpanOptions, ToleranceOptions, Witness, Work,
 };
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
-use rayon::prelude::*;
-use std::cell::RefCell;
-use std::sync::{Arc, Mutex};
+use std::num::NonZeroUsize;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// `rule=` values: which tree a traversal descends when both can be.
@@ -34,26 +33,6 @@ fn rule(name: &str) -> Result<DescentRule, Failure> {
             format!("rule {other:?} is not one of diameter, volume, area, a, b"),
         )),
     }
-}
-
-/// Thread pools made for `threads=N`, kept for later calls (making one costs far more than
-/// a small batch).
-static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
-
-fn pool(threads: usize) -> Result<Arc<rayon::ThreadPool>, Failure> {
-    let mut pools = POOLS
-        .lock()
-        .map_err(|_| Failure::new(Kind::Base, "the thread pool cache is poisoned"))?;
-    if let Some((_, p)) = pools.iter().find(|(n, _)| *n == threads) {
-        return Ok(p.clone());
-    }
-    let made = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Failure::new(Kind::Option, format!("threads={threads}: {e}")))?;
-    let made = Arc::new(made);
-    pools.push((threads, made.clone()));
-    Ok(made)
 }
 
 /// The checked `threads=` argument.
@@ -113,93 +92,14 @@ impl Batch {
     {
         let pa = self.poses_a.parse(self.orthonormalize)?;
         let pb = self.poses_b.parse(self.orthonormalize)?;
-        let (na, nb) = (pa.len(), pb.len());
-        let n = match (self.poses_a.single, self.poses_b.single) {
-            (true, true) => 1,
-            (true, false) => nb,
-            (false, true) => na,
-            (false, false) if na == nb => na,
-            (false, false) => {
-                return Err(Failure::new(
-                    Kind::Pose,
-                    format!(
-                        "poses_a holds {na} poses and poses_b {nb}: give batches of one length, or one pose to broadcast"
-                    ),
-                ))
-            }
+        let poses = PoseBatch::new(&pa, &pb)?;
+        let options = BatchOptions {
+            threads: self.threads.and_then(NonZeroUsize::new),
         };
-        let at = |poses: &[Pose], single: bool, i: usize| -> Pose {
-            let k = if single { 0 } else { i };
-            poses.get(k).copied().unwrap_or_default()
-        };
-        let (a, b) = (&*self.a, &*self.b);
-        // Checks the pair once (same volume type and precision), also for an empty batch.
-        let mut first = Pooled::new(a, b)?;
-        let (sa, sb) = (self.poses_a.single, self.poses_b.single);
-        let one = |pooled: &mut Pooled<'_>, i: usize| -> Result<T, Failure> {
-            let pair = pooled.pair()?;
-            Ok(query(pair, &at(&pa, sa, i), &at(&pb, sb, i))?)
-        };
-        if n <= 1 || self.threads == Some(1) {
-            return (0..n).map(|i| one(&mut first, i)).collect();
-        }
-        drop(first);
-        let parallel = || {
-            (0..n)
-                .into_par_iter()
-                .with_min_len(4)
-                .map_init(
-                    || Pooled::new(a, b),
-                    |pooled, i| match pooled {
-                        Ok(pooled) => one(pooled, i),
-                        Err(e) => Err(Failure::from(e.clone())),
-                    },
-                )
-                .collect::<Result<Vec<T>, Failure>>()
-        };
-        match self.threads {
-            None => parallel(),
-            Some(k) => pool(k)?.install(parallel),
-        }
-    }
-}
-
-thread_local! {
-    /// Traversal scratch kept per thread between calls, so that a query's buffers grow to
-    /// its traversal's size once per thread, not once per call.
-    static SCRATCH: RefCell<Option<QueryContext>> = const { RefCell::new(None) };
-}
-
-/// A `PairQuery` made with this thread's kept scratch, which it gives back when dropped.
-struct Pooled<'f>(Option<PairQuery<'f>>);
-
-impl<'f> Pooled<'f> {
-    fn new(a: &'f ObbtFile, b: &'f ObbtFile) -> Result<Pooled<'f>, QueryError> {
-        let context = SCRATCH
-            .try_with(|s| s.try_borrow_mut().ok().and_then(|mut s| s.take()))
-            .ok()
-            .flatten()
-            .unwrap_or_default();
-        Ok(Pooled(Some(PairQuery::with_context(a, b, context)?)))
-    }
-
-    fn pair(&mut self) -> Result<&mut PairQuery<'f>, Failure> {
-        self.0
-            .as_mut()
-            .ok_or_else(|| Failure::new(Kind::Base, "the pair query was released"))
-    }
-}
-
-impl Drop for Pooled<'_> {
-    fn drop(&mut self) {
-        if let Some(pair) = self.0.take() {
-            let context = pair.into_context();
-            let _ = SCRATCH.try_with(|s| {
-                if let Ok(mut s) = s.try_borrow_mut() {
-                    *s = Some(context);
-                }
-            });
-        }
+        batch(&self.a, &self.b, poses, &options, query)?
+            .into_iter()
+            .map(|answer| answer.map_err(Failure::from))
+            .collect()
     }
 }
 
@@ -571,8 +471,8 @@ witness_getters!(SpanResult, "of the farthest pair", {
 ///
 /// a, b: `Tree`s (same volume type and precision). poses_a, poses_b: one pose — a (4, 4)
 /// rigid matrix, 12 numbers (rotation row-major, then translation) or an (R, t) pair — or
-/// a batch (N, 4, 4) or (N, 12) (or (R (N, 3, 3), t (N, 3))). A single pose broadcasts
-/// against a batch; two single poses give N = 1. World point = R p + t.
+/// a batch (N, 4, 4) or (N, 12) (or (R (N, 3, 3), t (N, 3))). A single pose (or a batch
+/// of one) broadcasts against a batch; two single poses give N = 1. World point = R p + t.
 ///
 /// first_contact: stop at the first contact (a yes/no answer with one witness pair; much
 /// faster). pairs: False skips building the pair lists. threads: None for every core, or

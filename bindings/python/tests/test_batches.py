@@ -74,6 +74,9 @@ def test_single_pose_broadcasts(cow, poses):
     r3 = obbtree.collide(cow, b, cow, fixed)
     r4 = obbtree.collide(cow, b, cow, np.tile(fixed, (N, 1, 1)))
     assert np.array_equal(r3.contacts, r4.contacts)
+    # A batch of one broadcasts as a single pose does.
+    r5 = obbtree.collide(cow, fixed[None], cow, b)
+    assert np.array_equal(r1.contacts, r5.contacts)
 
 
 def test_empty_batch(cow):
