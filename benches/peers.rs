@@ -17,11 +17,14 @@
 //!   of distance bounds);
 //! - `bunny`, `fandisk`, `bunny-fandisk` (from `../shared/meshes`, skipped without them): B
 //!   turned at random and moved along a random direction by 0.3, 0.6, 0.9, 1.2 and 3 times
-//!   the larger model's bounding-box diagonal: touching, near and far poses.
+//!   the larger model's bounding-box diagonal: touching, near and far poses;
+//! - `boeing-ALSTOM_TEST4`, `anchor-boeing`, `ALSTOM_TEST4-ALSTOM_TEST4` (CAD parts of long
+//!   thin triangles from `../shared/meshes/cad`, unit bounding spheres): 24 random poses,
+//!   translations in a ball of radius 1.6.
 //!
 //! Printed: per pose the times and ratios; per query kind the geometric mean of the ratios
-//! (obbtree / peer: below 1 is faster), with the issue's targets; build time and in-memory
-//! bytes per triangle. Run: `cargo bench --bench peers` (about 5 minutes with every peer).
+//! (obbtree / peer: below 1 is faster) and the worst case (the case whose ratios have the
+//! largest geometric mean); build time and in-memory bytes per triangle. Run: `cargo bench --bench peers` (about 5 minutes with every peer).
 // A benchmark of known-good inputs: a setup that fails is a broken benchmark, not bad input.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
@@ -188,7 +191,10 @@ fn measure(pair: &mut PairQuery<'_>, pa: &Pose, pb: &Pose) -> Ours {
 /// Ratios collected per query kind, for the geometric means.
 #[derive(Default)]
 struct Ratios {
-    kinds: Vec<(&'static str, Vec<f64>)>,
+    /// Per kind: each ratio and the case it came from.
+    kinds: Vec<(&'static str, Vec<(f64, String)>)>,
+    /// The case running.
+    case: String,
 }
 
 impl Ratios {
@@ -197,9 +203,10 @@ impl Ratios {
             return "—".into();
         };
         let ratio = ours / peer;
+        let case = self.case.clone();
         match self.kinds.iter_mut().find(|(k, _)| *k == kind) {
-            Some((_, v)) => v.push(ratio),
-            None => self.kinds.push((kind, vec![ratio])),
+            Some((_, v)) => v.push((ratio, case)),
+            None => self.kinds.push((kind, vec![(ratio, case)])),
         }
         format!("{ratio:.2}")
     }
@@ -428,7 +435,11 @@ fn main() {
         }
     }
     let scratch = std::env::temp_dir().join(format!("obbtree-peers-{}", std::process::id()));
-    let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    // Names given on the command line pick the cases whose name contains one of them.
+    let filters: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
     let mut cases = vec![];
     let big = common::uv_sphere(1.0, 101, 200);
     let small = common::uv_sphere(0.8, 101, 200);
@@ -468,14 +479,36 @@ fn main() {
             _ => println!("../shared/meshes/{na} or {nb} not found: case skipped"),
         }
     }
+    // The CAD parts of issue 25 (long thin triangles; each normalised to a unit bounding
+    // sphere), under the issue's poses: `obbtree poses random --count 24 --radius 1.6 --seed 7`.
+    let cad = [
+        ("boeing", "ALSTOM_TEST4"),
+        ("anchor", "boeing"),
+        ("ALSTOM_TEST4", "ALSTOM_TEST4"),
+    ];
+    let cad_poses: Vec<(Pose, Pose)> = obbtree::generate::random_poses(24, 1.6, 7)
+        .expect("poses")
+        .into_iter()
+        .map(|[a, b]| (a, b))
+        .collect();
+    for (na, nb) in cad {
+        let load = |n: &str| common::shared_mesh(&format!("cad/{n}.obj"));
+        match (load(na), load(nb)) {
+            (Some(a), Some(b)) => cases.push(Case {
+                name: format!("{na}-{nb}"),
+                a,
+                b,
+                poses: cad_poses.clone(),
+            }),
+            _ => println!("../shared/meshes/cad/{na}.obj or {nb}.obj not found: case skipped"),
+        }
+    }
     let mut ratios = Ratios::default();
     for case in &cases {
-        if filter
-            .as_ref()
-            .is_some_and(|f| !case.name.contains(f.as_str()))
-        {
+        if !filters.is_empty() && !filters.iter().any(|f| case.name.contains(f.as_str())) {
             continue;
         }
+        ratios.case.clone_from(&case.name);
         run_case(case, &peers, &scratch, &mut ratios);
     }
     if std::env::var_os("OBBTREE_PEERS_KEEP").is_none() {
@@ -483,14 +516,35 @@ fn main() {
     } else {
         println!("cases kept in {}", scratch.display());
     }
-    println!("\n## Geometric means of obbtree / peer (below 1: obbtree is faster)");
+    println!(
+        "\n## Geometric means of obbtree / peer (below 1: obbtree is faster), and the worst case"
+    );
     for (kind, values) in &ratios.kinds {
-        let gm = (values.iter().map(|v| v.ln()).sum::<f64>() / values.len() as f64).exp();
+        let gm = (values.iter().map(|(v, _)| v.ln()).sum::<f64>() / values.len() as f64).exp();
+        // The worst case: the largest geometric mean of one case's ratios.
+        let mut cases: Vec<&str> = values.iter().map(|(_, c)| c.as_str()).collect();
+        cases.dedup();
+        let worst = cases
+            .iter()
+            .map(|c| {
+                let of: Vec<f64> = values
+                    .iter()
+                    .filter(|(_, k)| k == c)
+                    .map(|(v, _)| v.ln())
+                    .collect();
+                ((of.iter().sum::<f64>() / of.len() as f64).exp(), *c)
+            })
+            .max_by(|x, y| x.0.total_cmp(&y.0))
+            .expect("a ratio");
         let (lo, hi) = values
             .iter()
-            .fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
+            .fold((f64::INFINITY, 0.0f64), |(l, h), (v, _)| {
+                (l.min(*v), h.max(*v))
+            });
         println!(
-            "{kind:<32} {gm:>6.2}  (n = {:>2}, {lo:.2} … {hi:.2})",
+            "{kind:<32} {gm:>6.2}  worst case {:>5.2} ({})  (n = {:>3}, {lo:.2} … {hi:.2})",
+            worst.0,
+            worst.1,
             values.len()
         );
     }
