@@ -5,7 +5,7 @@
 //! distance, spheres of radii 1 and 1.05); X the sliding position
 //! (0.2 … 2.2), or with DIR (a case kept by `OBBTREE_PEERS_KEEP=1 cargo bench --bench
 //! peers`: `a.obj`, `b.obj`, `poses.txt`) the index of a pose line. Prints the work of one
-//! query and the median time per query.
+//! query and the median time per query. Trees are f32 unless `OBBTREE_PRECISION=f64`.
 // A tool developers run by hand: stopping loudly on a broken input is what it should do.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
@@ -22,7 +22,14 @@ fn main() {
     let kind = args.get(1).map_or("all", |s| s.as_str());
     let x: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1.0);
     let runs: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1000);
-    let options = BuildOptions::default();
+    // `OBBTREE_PRECISION=f64` profiles f64 trees (the default is the library's, f32).
+    let options = match std::env::var("OBBTREE_PRECISION").as_deref() {
+        Ok("f64") => BuildOptions {
+            precision: obbtree::real::Precision::F64,
+            ..BuildOptions::default()
+        },
+        _ => BuildOptions::default(),
+    };
     let case = args.get(4).map(std::path::PathBuf::from);
     let (mesh_a, mesh_b) = match &case {
         Some(dir) => (

@@ -91,6 +91,8 @@ pub trait Real:
     fn from_f64_down(x: f64) -> Self;
     /// Exact widening to f64.
     fn to_f64(self) -> f64;
+    /// Narrowing to f32: exact for f32 (the f32 box test reads stored values through it).
+    fn to_f32(self) -> f32;
     /// Writes the little-endian encoding into the first `size_of::<Self>()` bytes of `out`
     /// (fewer if `out` is shorter).
     fn write_le(self, out: &mut [u8]);
@@ -115,6 +117,9 @@ impl Real for f32 {
     fn to_f64(self) -> f64 {
         f64::from(self)
     }
+    fn to_f32(self) -> f32 {
+        self
+    }
     fn write_le(self, out: &mut [u8]) {
         for (o, b) in out.iter_mut().zip(self.to_le_bytes()) {
             *o = b;
@@ -136,6 +141,11 @@ impl Real for f64 {
     }
     fn to_f64(self) -> f64 {
         self
+    }
+    // Rounds (used only by generic code that f64 volumes never reach).
+    #[allow(clippy::cast_possible_truncation)]
+    fn to_f32(self) -> f32 {
+        self as f32
     }
     fn write_le(self, out: &mut [u8]) {
         for (o, b) in out.iter_mut().zip(self.to_le_bytes()) {

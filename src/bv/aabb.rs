@@ -40,6 +40,13 @@ impl<R: Real> Aabb<R> {
         (c, Matrix3::identity(), h, 0.0)
     }
 
+    /// The separating-axis test (see [`BoxPair::disjoint`]).
+    #[inline(always)]
+    fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+        self.pair_with(other, b_to_a, PairSetup::Fast)
+            .disjoint(guard)
+    }
+
     #[inline]
     fn pair_with(&self, other: &Self, b_to_a: &Pose, _setup: PairSetup) -> BoxPair {
         let (ca, ha) = self.center_half();

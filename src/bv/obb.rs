@@ -85,6 +85,18 @@ impl<R: Real> Obb<R> {
         BoxPair::from_offset(&axes_a, ha, &axes_b, hb, &offset, b_to_a.rotation(), tol)
     }
 
+    /// The separating-axis test: on the stored values where they are f32
+    /// ([`super::sat_f32`]), else in f64 ([`BoxPair::disjoint`]).
+    #[inline(always)]
+    fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+        if R::PRECISION == Precision::F32 {
+            super::sat_f32::disjoint(self, other, b_to_a, guard)
+        } else {
+            self.pair_with(other, b_to_a, PairSetup::Fast)
+                .disjoint(guard)
+        }
+    }
+
     /// Centre, axes (rows), half-widths and the frame's orthonormality tolerance, in f64.
     fn local_box(&self) -> (Vector3<f64>, Matrix3<f64>, Vector3<f64>, f64) {
         (

@@ -356,16 +356,15 @@ pub(crate) enum PairSetup {
 }
 
 /// The pair tests and size measures shared by the two box volumes, written once: both types
-/// provide `pair_with(&self, &Self, &Pose, PairSetup) -> BoxPair`,
+/// provide `disjoint(&self, &Self, &Pose, guard) -> bool` (the separating-axis test),
+/// `pair_with(&self, &Self, &Pose, PairSetup) -> BoxPair`,
 /// `half_f64(&self) -> [f64; 3]` and `local_box(&self)` (centre, axes as rows, half-widths,
 /// frame error, all f64 in the model frame).
 macro_rules! box_pair_methods {
     () => {
         #[inline]
         fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
-            !self
-                .pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Fast)
-                .disjoint(guard)
+            !self.disjoint(other, b_to_a, guard)
         }
 
         #[inline]

@@ -189,6 +189,60 @@ proptest! {
         }
     }
 
+    /// The f32 box test (on the stored f32 values, `bv::sat_f32`) is at least as
+    /// conservative as the f64 test of the same stored boxes, and hardly looser: along a
+    /// random direction from coinciding centres, at the f64 test's last overlapping
+    /// offset (bisected to the last bit) the f32 test reports overlap too, and a
+    /// thousandth further out it reports them apart (its slack is a few millionths of the
+    /// offset and sizes, divided on an edge-edge axis by that axis's length, which for
+    /// nearly parallel edges is small). Thin boxes (a half-width of 1e-7, slivers'
+    /// leaves) and boxes far from the origin included.
+    #[test]
+    fn f32_box_test_is_as_conservative_as_f64(
+        a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose(),
+        thin in 0..4usize, far in prop_oneof![Just(0.0), Just(1e3)],
+    ) {
+        let narrow = |o: &Obb<f64>, shift: f64| {
+            let mut f = Obb::<f32> {
+                axes: o.axes.map(|r| r.map(|v| v as f32)),
+                center: o.center.map(|v| (v + shift) as f32),
+                half: o.half.map(|v| v as f32),
+            };
+            if let Some(h) = f.half.get_mut(thin) {
+                *h = 1e-7;
+            }
+            f
+        };
+        let (fa, fb) = (narrow(&a, far), narrow(&b, -far));
+        let wide = |f: &Obb<f32>| {
+            (
+                Matrix3::from_fn(|i, j| f64::from(f.axes[i][j])),
+                Vector3::from(f.center.map(f64::from)),
+                Vector3::from(f.half.map(f64::from)),
+            )
+        };
+        let ((axes_a, ca, ha), (axes_b, cb, hb)) = (wide(&fa), wide(&fb));
+        let r = *b_to_a.rotation();
+        let toward = b_to_a.translation_vector();
+        prop_assume!(toward.norm() > 1e-3);
+        let direction = toward.normalize();
+        // B's centre on A's at s = 0, then s along `direction`.
+        let pose_at = |s: f64| Pose::new(r, ca - r * cb + direction * s).unwrap();
+        let f64_disjoint = |s: f64| {
+            BoxPair::new(&axes_a, &ca, ha, &axes_b, &cb, hb, &pose_at(s), 1e-6).disjoint(SAT_GUARD)
+        };
+        let f32_disjoint = |s: f64| !fa.overlaps(&fb, &pose_at(s), SAT_GUARD);
+        let (mut lo, mut hi) = (0.0f64, 10.0f64);
+        prop_assume!(!f64_disjoint(lo) && f64_disjoint(hi));
+        while hi - lo > f64::EPSILON * hi {
+            let mid = 0.5 * (lo + hi);
+            if f64_disjoint(mid) { hi = mid } else { lo = mid }
+        }
+        prop_assert!(!f32_disjoint(lo), "f32 test reports disjoint at the f64 test's overlapping offset {lo}");
+        prop_assert!(!f32_disjoint(0.5 * lo), "f32 test reports disjoint inside the f64 test's overlap");
+        prop_assert!(f32_disjoint(hi * (1.0 + 1e-3) + 1e-3), "f32 test still overlapping a thousandth past {hi}");
+    }
+
     #[test]
     fn overlap_is_never_missed(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
         // If some point of B lies inside A, the boxes overlap and the test must say so.
@@ -499,15 +553,23 @@ fn separation_is_reported_at_the_edge_of_the_slack() {
             );
         }
     }
-    // Stored f32 boxes get the f32 frame tolerance, 1e-6, whatever their axes.
+    // Stored f32 boxes are tested in f32 (`bv::sat_f32`): the f32 frame tolerance, 1e-6,
+    // whatever their axes, 17u more guard and 64u (|t|₁ + Σ half-widths) more slack, with u
+    // f32's unit roundoff. Its rounding of the guard and slack up to f32 moves the edge by
+    // up to a few 1e-7 of itself, so the edge is pinned to 1e-6 here (dropping the f32
+    // slack would move it by 1.6e-5, the f32 guard by 1.5e-6).
     let hf = 1e-3f32;
     let cube = Obb::<f32> {
         axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         center: [0.0; 3],
         half: [hf; 3],
     };
-    let edge = cube_separation(f64::from(hf), y, 1e-6);
-    for (scale, apart) in [(1.0 - 1e-9, false), (1.0 + 1e-9, true)] {
+    let (h, u) = (f64::from(hf), f64::from(f32::EPSILON) / 2.0);
+    let k = 4.0 * 1e-6 + OFFSET_ROUNDING + 64.0 * u;
+    let guard = SAT_GUARD + 17.0 * u;
+    let edge =
+        (2.0 * h + 3.0 * guard * h + 6.0 * SAT_GUARD * h + 64.0 * u * 6.0 * h + k * y) / (1.0 - k);
+    for (scale, apart) in [(1.0 - 1e-6, false), (1.0 + 1e-6, true)] {
         let pose = Pose::translation(edge * scale, y, 0.0);
         assert_eq!(
             !cube.overlaps(&cube, &pose, SAT_GUARD),
