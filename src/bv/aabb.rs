@@ -40,6 +40,14 @@ impl<R: Real> Aabb<R> {
         (c, Matrix3::identity(), h, 0.0)
     }
 
+    /// The distance lower bound ([`BoxPair::distance_lower_bound_until`]) and the centres'
+    /// distance.
+    #[inline(always)]
+    fn distance_bound(&self, other: &Self, b_to_a: &Pose, enough: f64) -> (f64, f64) {
+        let pair = self.pair_with(other, b_to_a, PairSetup::Metric);
+        (pair.distance_lower_bound_until(enough), pair.t.norm())
+    }
+
     /// The separating-axis test (see [`BoxPair::disjoint`]).
     #[inline(always)]
     fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {

@@ -9,7 +9,7 @@ mod aabb;
 mod ball;
 mod obb;
 pub mod pair;
-mod sat_f32;
+mod pair_f32;
 mod sphere;
 
 pub use aabb::Aabb;

@@ -85,12 +85,36 @@ impl<R: Real> Obb<R> {
         BoxPair::from_offset(&axes_a, ha, &axes_b, hb, &offset, b_to_a.rotation(), tol)
     }
 
+    /// The distance lower bound ([`BoxPair::distance_lower_bound_until`]) and the centres'
+    /// distance: for f32 boxes their face-axis and direction terms on the stored values
+    /// ([`super::pair_f32`]), the f64 bound where it would go on to the edge-edge axes or
+    /// re-orthonormalise the frames.
+    #[inline(always)]
+    fn distance_bound(&self, other: &Self, b_to_a: &Pose, enough: f64) -> (f64, f64) {
+        if R::PRECISION == Precision::F32 {
+            let tol = axis_tolerance(R::PRECISION);
+            let far = |offset_norm1: f64, halves: f64| {
+                4.0 * tol * offset_norm1 > FAR * SAT_GUARD * halves
+            };
+            match super::pair_f32::distance_lower_bound_until(self, other, b_to_a, enough, far) {
+                Some((bound, centres, false)) => return (bound, centres),
+                Some((bound, centres, true)) => {
+                    let pair = self.pair_with(other, b_to_a, PairSetup::Metric);
+                    return (bound.max(pair.distance_lower_bound_until(enough)), centres);
+                }
+                None => {}
+            }
+        }
+        let pair = self.pair_with(other, b_to_a, PairSetup::Metric);
+        (pair.distance_lower_bound_until(enough), pair.t.norm())
+    }
+
     /// The separating-axis test: on the stored values where they are f32
-    /// ([`super::sat_f32`]), else in f64 ([`BoxPair::disjoint`]).
+    /// ([`super::pair_f32`]), else in f64 ([`BoxPair::disjoint`]).
     #[inline(always)]
     fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
         if R::PRECISION == Precision::F32 {
-            super::sat_f32::disjoint(self, other, b_to_a, guard)
+            super::pair_f32::disjoint(self, other, b_to_a, guard)
         } else {
             self.pair_with(other, b_to_a, PairSetup::Fast)
                 .disjoint(guard)

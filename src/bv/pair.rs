@@ -21,7 +21,7 @@ const PROJECTION_STEPS: usize = 1;
 /// How near the closest-direction gap must come to the distance of the points it was
 /// taken between (at least the box distance) for the edge-edge axes to be skipped: they
 /// could then raise the bound by at most 10%.
-const CONVERGED: f64 = 0.9;
+pub(crate) const CONVERGED: f64 = 0.9;
 
 /// Two boxes in the frame of box A: A is centred at the origin with axes along x, y, z and
 /// half-widths `ha`; B is centred at `t` with axes the columns of `m` and half-widths `hb`.
@@ -357,6 +357,8 @@ pub(crate) enum PairSetup {
 
 /// The pair tests and size measures shared by the two box volumes, written once: both types
 /// provide `disjoint(&self, &Self, &Pose, guard) -> bool` (the separating-axis test),
+/// `distance_bound(&self, &Self, &Pose, enough) -> (f64, f64)` (the distance lower bound
+/// and the centres' distance),
 /// `pair_with(&self, &Self, &Pose, PairSetup) -> BoxPair`,
 /// `half_f64(&self) -> [f64; 3]` and `local_box(&self)` (centre, axes as rows, half-widths,
 /// frame error, all f64 in the model frame).
@@ -376,8 +378,7 @@ macro_rules! box_pair_methods {
 
         #[inline]
         fn distance_lower_bound_until(&self, other: &Self, b_to_a: &Pose, enough: f64) -> f64 {
-            self.pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Metric)
-                .distance_lower_bound_until(enough)
+            self.distance_bound(other, b_to_a, enough).0
         }
 
         /// `|t|`, B's centre in A's box frame, is the centres' distance.
@@ -388,8 +389,7 @@ macro_rules! box_pair_methods {
             b_to_a: &Pose,
             enough: f64,
         ) -> (f64, f64) {
-            let pair = self.pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Metric);
-            (pair.distance_lower_bound_until(enough), pair.t.norm())
+            self.distance_bound(other, b_to_a, enough)
         }
 
         #[inline]

@@ -1,0 +1,547 @@
+//! The box pair tests of two f32 boxes on the stored f32 values: the separating-axis
+//! test and the face-axis and direction terms of the distance lower bound, four lanes per
+//! operation where the f64 tests of [`super::pair::BoxPair`] take one or two, and no
+//! widening of the 30 stored numbers. Exactly as conservative as the f64 tests: every
+//! rounding of the f32 arithmetic is bounded and added to the guard and the slack, so a
+//! pair the f64 overlap test keeps is kept here too, and the bound stays below the boxes'
+//! distance.
+//!
+//! Only B's axes in A's box frame (`m`) are computed in f32. The centre offset `t` is
+//! computed in f64, as the f64 tests do, and then rounded: in f32 its error would be
+//! relative to the models' coordinates rather than to `t`, and inflate small boxes far
+//! from the origin.
+//!
+//! Error bounds (u = 2⁻²⁴, rows of unit length within the f32 axis tolerance):
+//!
+//! - each entry of `m` is off by at most 16u: the pose's rotation rounded to f32 (u per
+//!   entry), then two 3-term dot products of unit-length rows (3u each, the second
+//!   carrying the first's error through a row of 1-norm at most √3);
+//! - `t` rounded to f32 is off by u per component;
+//! - a projection of `t` on an axis (a 3-term or 2-term combination of `t` and `m`) is
+//!   off by at most 40u·|t|₁, and a radius (sums of half-widths times guarded `|m|`) is
+//!   under-estimated by at most 8u of itself, the comparisons' sums by 2u;
+//! - the gap along a direction `d` (`(d·t − Σ ha|d_i| − Σ hb|(mᵀd)_j|) / |d|`, a lower
+//!   bound for any `d` when computed exactly) is off by at most 33u·(|t|₁ + Σ
+//!   half-widths), and by 8u of itself for the division and the square root.
+//!
+//! So `|m|` gets 17u more guard than the f64 test's, every comparison and face-axis gap
+//! `64u·(|t|₁ + Σ half-widths)` more slack, and the direction's gap that slack and 8u of
+//! itself.
+
+use super::pair::{CONVERGED, OFFSET_ROUNDING, SAT_GUARD};
+use super::Obb;
+use crate::pose::Pose;
+use crate::real::Real;
+use nalgebra::Vector3;
+
+/// f32's unit roundoff, 2⁻²⁴.
+const U: f64 = f32::EPSILON as f64 / 2.0;
+
+/// Three f32 lanes and a fourth that stays 0, in one SSE register on x86-64 (SSE2 is part
+/// of that target's baseline, so no run-time detection is needed) and as an array
+/// elsewhere.
+#[derive(Clone, Copy, Debug)]
+struct F4(lanes::V);
+
+// SAFETY (every `unsafe` block of this module): the intrinsics are SSE and SSE2
+// instructions, which the cfg below guarantees are enabled for the whole build (they are in
+// the x86-64 baseline), so every CPU this code runs on has them; only `load` and `store`
+// touch memory, the 16 bytes of the array each is given.
+#[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+mod lanes {
+    use std::arch::x86_64::*;
+
+    pub type V = __m128;
+
+    #[inline(always)]
+    pub fn new(x: f32, y: f32, z: f32) -> V {
+        unsafe { _mm_set_ps(0.0, z, y, x) }
+    }
+    #[inline(always)]
+    pub fn splat(v: f32) -> V {
+        unsafe { _mm_set_ps(0.0, v, v, v) }
+    }
+    /// The four values, in order.
+    #[inline(always)]
+    pub fn load(v: &[f32; 4]) -> V {
+        // (A read of the 16 bytes the reference covers.)
+        unsafe { _mm_loadu_ps(v.as_ptr()) }
+    }
+    /// The four lanes, in order.
+    #[inline(always)]
+    pub fn store(v: V) -> [f32; 4] {
+        let mut out = [0.0f32; 4];
+        // (A write of the 16 bytes of `out`.)
+        unsafe { _mm_storeu_ps(out.as_mut_ptr(), v) };
+        out
+    }
+    #[inline(always)]
+    pub fn add(a: V, b: V) -> V {
+        unsafe { _mm_add_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn sub(a: V, b: V) -> V {
+        unsafe { _mm_sub_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn mul(a: V, b: V) -> V {
+        unsafe { _mm_mul_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn abs(a: V) -> V {
+        unsafe { _mm_andnot_ps(_mm_set1_ps(-0.0), a) }
+    }
+    /// Lane `k` of `a` in lanes 0 to 2 (and in lane 3, which callers multiply by 0).
+    #[inline(always)]
+    pub fn broadcast<const K: i32>(a: V) -> V {
+        unsafe { _mm_shuffle_ps::<K>(a, a) }
+    }
+    pub const LANE_0: i32 = 0b00_00_00_00;
+    pub const LANE_1: i32 = 0b01_01_01_01;
+    pub const LANE_2: i32 = 0b10_10_10_10;
+    /// `(y, z, x, w)`.
+    #[inline(always)]
+    pub fn rot1(a: V) -> V {
+        unsafe { _mm_shuffle_ps::<0b11_00_10_01>(a, a) }
+    }
+    /// `(z, x, y, w)`.
+    #[inline(always)]
+    pub fn rot2(a: V) -> V {
+        unsafe { _mm_shuffle_ps::<0b11_01_00_10>(a, a) }
+    }
+    /// Whether a lane of 0 to 2 of `a` exceeds `b`'s (false with NaN).
+    #[inline(always)]
+    pub fn any_gt(a: V, b: V) -> bool {
+        unsafe { _mm_movemask_ps(_mm_cmpgt_ps(a, b)) & 0b111 != 0 }
+    }
+    /// The columns of the rows `r` (lane 3 of each row 0).
+    #[inline(always)]
+    pub fn transpose(r: [V; 3]) -> [V; 3] {
+        let [r0, r1, r2] = r;
+        let zero = unsafe { _mm_setzero_ps() };
+        let (t0, t1) = unsafe { (_mm_unpacklo_ps(r0, r1), _mm_unpacklo_ps(r2, zero)) };
+        let (t2, t3) = unsafe { (_mm_unpackhi_ps(r0, r1), _mm_unpackhi_ps(r2, zero)) };
+        unsafe {
+            [
+                _mm_movelh_ps(t0, t1),
+                _mm_movehl_ps(t1, t0),
+                _mm_movelh_ps(t2, t3),
+            ]
+        }
+    }
+}
+
+#[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+mod lanes {
+    pub type V = [f32; 4];
+
+    #[inline(always)]
+    fn zip(a: V, b: V, f: impl Fn(f32, f32) -> f32) -> V {
+        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a, b);
+        [f(a0, b0), f(a1, b1), f(a2, b2), f(a3, b3)]
+    }
+    #[inline(always)]
+    pub fn new(x: f32, y: f32, z: f32) -> V {
+        [x, y, z, 0.0]
+    }
+    #[inline(always)]
+    pub fn splat(v: f32) -> V {
+        [v, v, v, 0.0]
+    }
+    #[inline(always)]
+    pub fn load(v: &[f32; 4]) -> V {
+        *v
+    }
+    #[inline(always)]
+    pub fn store(v: V) -> [f32; 4] {
+        v
+    }
+    #[inline(always)]
+    pub fn add(a: V, b: V) -> V {
+        zip(a, b, |x, y| x + y)
+    }
+    #[inline(always)]
+    pub fn sub(a: V, b: V) -> V {
+        zip(a, b, |x, y| x - y)
+    }
+    #[inline(always)]
+    pub fn mul(a: V, b: V) -> V {
+        zip(a, b, |x, y| x * y)
+    }
+    #[inline(always)]
+    pub fn abs(a: V) -> V {
+        let [x, y, z, w] = a;
+        [x.abs(), y.abs(), z.abs(), w.abs()]
+    }
+    #[inline(always)]
+    pub fn broadcast<const K: i32>(a: V) -> V {
+        let [x, y, z, _] = a;
+        splat(match K {
+            LANE_0 => x,
+            LANE_1 => y,
+            _ => z,
+        })
+    }
+    pub const LANE_0: i32 = 0;
+    pub const LANE_1: i32 = 1;
+    pub const LANE_2: i32 = 2;
+    #[inline(always)]
+    pub fn rot1(a: V) -> V {
+        let [x, y, z, w] = a;
+        [y, z, x, w]
+    }
+    #[inline(always)]
+    pub fn rot2(a: V) -> V {
+        let [x, y, z, w] = a;
+        [z, x, y, w]
+    }
+    #[inline(always)]
+    pub fn any_gt(a: V, b: V) -> bool {
+        let ([a0, a1, a2, _], [b0, b1, b2, _]) = (a, b);
+        (a0 > b0) | (a1 > b1) | (a2 > b2)
+    }
+    #[inline(always)]
+    pub fn transpose(r: [V; 3]) -> [V; 3] {
+        let [[a, b, c, _], [d, e, f, _], [g, h, i, _]] = r;
+        [new(a, d, g), new(b, e, h), new(c, f, i)]
+    }
+}
+
+impl F4 {
+    #[inline(always)]
+    fn new(x: f32, y: f32, z: f32) -> F4 {
+        F4(lanes::new(x, y, z))
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> F4 {
+        F4(lanes::splat(v))
+    }
+    #[inline(always)]
+    fn add(self, o: F4) -> F4 {
+        F4(lanes::add(self.0, o.0))
+    }
+    #[inline(always)]
+    fn sub(self, o: F4) -> F4 {
+        F4(lanes::sub(self.0, o.0))
+    }
+    #[inline(always)]
+    fn mul(self, o: F4) -> F4 {
+        F4(lanes::mul(self.0, o.0))
+    }
+    /// `self + a * b`.
+    #[inline(always)]
+    fn mul_add(self, a: F4, b: F4) -> F4 {
+        self.add(a.mul(b))
+    }
+    #[inline(always)]
+    fn abs(self) -> F4 {
+        F4(lanes::abs(self.0))
+    }
+    #[inline(always)]
+    fn lane0(self) -> F4 {
+        F4(lanes::broadcast::<{ lanes::LANE_0 }>(self.0))
+    }
+    #[inline(always)]
+    fn lane1(self) -> F4 {
+        F4(lanes::broadcast::<{ lanes::LANE_1 }>(self.0))
+    }
+    #[inline(always)]
+    fn lane2(self) -> F4 {
+        F4(lanes::broadcast::<{ lanes::LANE_2 }>(self.0))
+    }
+    /// The lanes moved one place down, cyclically over the three: `(y, z, x)`.
+    #[inline(always)]
+    fn rot1(self) -> F4 {
+        F4(lanes::rot1(self.0))
+    }
+    /// The lanes moved two places down: `(z, x, y)`.
+    #[inline(always)]
+    fn rot2(self) -> F4 {
+        F4(lanes::rot2(self.0))
+    }
+    /// Whether any of the three lanes exceeds `other`'s (false with NaN: not separated).
+    #[inline(always)]
+    fn any_gt(self, other: F4) -> bool {
+        lanes::any_gt(self.0, other.0)
+    }
+    /// The lanes as numbers.
+    #[inline(always)]
+    fn lanes(self) -> [f32; 4] {
+        lanes::store(self.0)
+    }
+    /// Lane by lane, the larger (NaN ignored, as `f64::max` does).
+    #[inline(always)]
+    fn max(self, o: F4) -> F4 {
+        let ([a, b, c, d], [e, f, g, h]) = (self.lanes(), o.lanes());
+        F4(lanes::load(&[a.max(e), b.max(f), c.max(g), d.max(h)]))
+    }
+    /// The largest of the three lanes, NaN ignored (as `f64::max` does).
+    #[inline(always)]
+    fn max_lane(self) -> f32 {
+        let [x, y, z, _] = self.lanes();
+        x.max(y).max(z)
+    }
+    /// The point of the box `[-h, h]` nearest to each lane (NaN passes through, as in
+    /// the f64 `clamp_box`).
+    #[inline(always)]
+    fn clamp(self, h: F4) -> F4 {
+        let ([x, y, z, _], [hx, hy, hz, _]) = (self.lanes(), h.lanes());
+        let c = |v: f32, h: f32| {
+            if v > h {
+                h
+            } else if v < -h {
+                -h
+            } else {
+                v
+            }
+        };
+        F4::new(c(x, hx), c(y, hy), c(z, hz))
+    }
+    /// The dot product of the three lanes.
+    #[inline(always)]
+    fn dot(self, o: F4) -> f32 {
+        let [x, y, z, _] = self.mul(o).lanes();
+        x + y + z
+    }
+}
+
+/// A non-negative `x` rounded to an f32 at least as large: the nearest f32 (at most u
+/// below `x`) raised by 4 ulps, which leaves room for the product's own rounding.
+/// (`Real::from_f64_up`, exact to the ulp, costs a select per call on this hot path.)
+#[inline(always)]
+fn up(x: f64) -> f32 {
+    (x as f32) * (1.0 + 4.0 * f32::EPSILON)
+}
+
+/// Rows of a 3×3 matrix as lanes, transposed: the columns.
+#[inline(always)]
+fn transpose(rows: [F4; 3]) -> [F4; 3] {
+    let [r0, r1, r2] = rows;
+    lanes::transpose([r0.0, r1.0, r2.0]).map(F4)
+}
+
+/// `Σ_k s_k rows_k`: the row vector `s` times the matrix of `rows`.
+#[inline(always)]
+fn combine(s: F4, rows: &[F4; 3]) -> F4 {
+    let [r0, r1, r2] = *rows;
+    r0.mul(s.lane0())
+        .mul_add(r1, s.lane1())
+        .mul_add(r2, s.lane2())
+}
+
+/// One edge-axis family of the separating-axis test, the three `a_i × b_j` of one `i` at
+/// once: `|t_i2 m_i1j − t_i1 m_i2j| > ha_i1 |m_i2j| + ha_i2 |m_i1j| + hb_j1 |m_ij2| +
+/// hb_j2 |m_ij1| + slack` for some `j`, where `(i1, i2)` follow `i` cyclically. The
+/// arguments are rows `i1` and `i2` of `m`, rows `i`, `i1`, `i2` of the guarded `|m|`, and
+/// the scalars splatted.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn edge_separates(
+    (m_i1, m_i2): (F4, F4),
+    (abs_i, abs_i1, abs_i2): (F4, F4, F4),
+    (t_i1, t_i2): (F4, F4),
+    (ha_i1, ha_i2): (F4, F4),
+    hb: F4,
+    slack: F4,
+) -> bool {
+    let tl = m_i1.mul(t_i2).sub(m_i2.mul(t_i1)).abs();
+    let ra = abs_i2.mul(ha_i1).mul_add(abs_i1, ha_i2);
+    let rb = hb.rot1().mul(abs_i.rot2()).mul_add(hb.rot2(), abs_i.rot1());
+    tl.any_gt(ra.add(rb).add(slack))
+}
+
+/// A box's axes as three rows and its half-widths, each loaded as four values: the three
+/// of the row and, in the fourth lane, the next stored number (which everything that
+/// reads the rows ignores: they are only broadcast lane by lane or transposed), and the
+/// half-widths with a 0 in the fourth lane.
+#[inline(always)]
+fn rows_and_half<R: Real>(o: &Obb<R>) -> ([F4; 3], F4) {
+    let [[a0, a1, a2], [a3, a4, a5], [a6, a7, a8]] = o.axes;
+    let [c0, _, _] = o.center;
+    let [h0, h1, h2] = o.half;
+    let f = |x: R| x.to_f32();
+    let rows = [
+        [f(a0), f(a1), f(a2), f(a3)],
+        [f(a3), f(a4), f(a5), f(a6)],
+        [f(a6), f(a7), f(a8), f(c0)],
+    ];
+    let half = [f(h0), f(h1), f(h2), 0.0];
+    (rows.map(|r| F4(lanes::load(&r))), F4(lanes::load(&half)))
+}
+
+/// Two f32 boxes in box A's frame, as [`super::pair::BoxPair`] holds two boxes in f64:
+/// B's axes `m` in f32 (each entry within 16u), the centre offset `t` in f64 and rounded,
+/// and the half-widths.
+struct F32Pair {
+    m: [F4; 3],
+    t: F4,
+    t64: [f64; 3],
+    ha: F4,
+    hb: F4,
+    /// `Σ ha`, `Σ hb`, `|t|₁` and the model-frame offset's `|·|₁`, in f64.
+    sum_a: f64,
+    sum_b: f64,
+    t_norm1: f64,
+    offset_norm1: f64,
+}
+
+impl F32Pair {
+    /// B (posed in A's model frame by `b_to_a`) in A's box frame. `R` is `f32` (see
+    /// [`Real::to_f32`], exact there).
+    #[inline(always)]
+    fn new<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose) -> F32Pair {
+        let (rows_a, ha) = rows_and_half(a);
+        let (rows_b, hb) = rows_and_half(b);
+        // The centre offset in f64, then in A's box frame (exact f32 axes, widened).
+        let ca = Vector3::from(a.center_f64());
+        let cb = Vector3::from(b.center_f64());
+        let offset = b_to_a.apply(&cb) - ca;
+        let [a0, a1, a2] = a.axes_f64();
+        let project = |[x, y, z]: [f64; 3]| x * offset.x + y * offset.y + z * offset.z;
+        let t64 = [project(a0), project(a1), project(a2)];
+        let [t0, t1, t2] = t64;
+        // m = A R Bᵀ, row by row: W = R Bᵀ (rows of R against B's columns), then m = A W.
+        let [p0, p1, p2]: [[f64; 3]; 3] = b_to_a.rotation().transpose().into();
+        let pose_row = |[x, y, z]: [f64; 3]| F4::new(x as f32, y as f32, z as f32);
+        let columns_b = transpose(rows_b);
+        let w = [
+            combine(pose_row(p0), &columns_b),
+            combine(pose_row(p1), &columns_b),
+            combine(pose_row(p2), &columns_b),
+        ];
+        let [r0, r1, r2] = rows_a;
+        F32Pair {
+            m: [combine(r0, &w), combine(r1, &w), combine(r2, &w)],
+            t: F4::new(t0 as f32, t1 as f32, t2 as f32),
+            t64,
+            ha,
+            hb,
+            sum_a: a.half_f64().iter().sum(),
+            sum_b: b.half_f64().iter().sum(),
+            t_norm1: t0.abs() + t1.abs() + t2.abs(),
+            offset_norm1: offset.abs().sum(),
+        }
+    }
+
+    /// The f64 test's slack ([`super::pair::BoxPair::slack`]) with f32 frames, plus the
+    /// f32 rounding bound of the module documentation.
+    #[inline(always)]
+    fn slack(&self, guard: f64) -> f64 {
+        let frame_error = super::obb::axis_tolerance(crate::real::Precision::F32);
+        guard * (self.sum_a + self.sum_b)
+            + (4.0 * frame_error + OFFSET_ROUNDING) * self.t_norm1
+            + 64.0 * U * (self.t_norm1 + self.sum_a + self.sum_b)
+    }
+
+    /// Whether the boxes are certainly disjoint, by the 15 separating axes, with `guard` as
+    /// in [`super::pair::BoxPair::disjoint`]: `true` only where that test also reports
+    /// them disjoint, up to the rounding bounds of the module documentation.
+    #[inline(always)]
+    fn disjoint(&self, guard: f64) -> bool {
+        let (m, t, ha, hb) = (self.m, self.t, self.ha, self.hb);
+        let slack = F4::splat(up(self.slack(guard)));
+        let g = F4::splat(up(guard + 17.0 * U));
+        let abs_m = [m[0].abs().add(g), m[1].abs().add(g), m[2].abs().add(g)];
+        // A's face axes, all three at once: |t_i| > ha_i + Σ_j hb_j |m_ij|.
+        let rb = combine(hb, &transpose(abs_m));
+        if t.abs().any_gt(ha.add(rb).add(slack)) {
+            return true;
+        }
+        // B's face axes: |Σ_i t_i m_ij| > Σ_i ha_i |m_ij| + hb_j.
+        let tb = combine(t, &m).abs();
+        let ra = combine(ha, &abs_m);
+        if tb.any_gt(ra.add(hb).add(slack)) {
+            return true;
+        }
+        // Edge axes a_i × b_j, the three j of one i at once:
+        // |t_i2 m_i1j − t_i1 m_i2j| > ha_i1 |m_i2j| + ha_i2 |m_i1j| + hb_j1 |m_ij2| + hb_j2 |m_ij1|.
+        let (tx, ty, tz) = (t.lane0(), t.lane1(), t.lane2());
+        let (hx, hy, hz) = (ha.lane0(), ha.lane1(), ha.lane2());
+        let [m0, m1, m2] = m;
+        let [abs0, abs1, abs2] = abs_m;
+        edge_separates((m1, m2), (abs0, abs1, abs2), (ty, tz), (hy, hz), hb, slack)
+            || edge_separates((m2, m0), (abs1, abs2, abs0), (tz, tx), (hz, hx), hb, slack)
+            || edge_separates((m0, m1), (abs2, abs0, abs1), (tx, ty), (hx, hy), hb, slack)
+    }
+
+    /// The first two terms of [`super::pair::BoxPair::distance_lower_bound_until`] in f32:
+    /// the face-axis gaps and, unless they reach `enough`, the gap along the direction of
+    /// the alternating projections' points. Each less the f64 slack and the f32 rounding
+    /// bound (for the direction's gap, also 8u of itself: its division and square root),
+    /// so a lower bound on the box distance. Also says whether the edge-edge axes could
+    /// still add to it (as the f64 bound decides: the direction's gap short of the points'
+    /// distance).
+    #[inline(always)]
+    fn distance_lower_bound_until(&self, enough: f64) -> (f64, bool) {
+        let (m, t, ha, hb) = (self.m, self.t, self.ha, self.hb);
+        let slack = self.slack(SAT_GUARD);
+        // The entries' error, as the overlap test's guard covers it (no §4.5 guard here,
+        // as in f64).
+        let g = F4::splat(up(17.0 * U));
+        let abs_m = [m[0].abs().add(g), m[1].abs().add(g), m[2].abs().add(g)];
+        let face_a = t.abs().sub(ha).sub(combine(hb, &transpose(abs_m)));
+        let face_b = combine(t, &m).abs().sub(combine(ha, &abs_m)).sub(hb);
+        let best = f64::from(face_a.max(face_b).max_lane()) - slack;
+        let best = best.max(0.0);
+        if best >= enough {
+            return (best, false);
+        }
+        // Alternating projections: B's centre clamped into A, the point of B nearest it,
+        // that clamped into A (PROJECTION_STEPS = 1 of the f64 bound).
+        let columns_m = transpose(m);
+        let p = t.clamp(ha);
+        let q = t.add(combine(combine(p.sub(t), &m).clamp(hb), &columns_m));
+        let p = q.clamp(ha);
+        let q = t.add(combine(combine(p.sub(t), &m).clamp(hb), &columns_m));
+        let d = q.sub(p);
+        let length2 = d.dot(d);
+        // (Points that meet, or NaN from a damaged file: no direction, and, as in f64,
+        // nothing more to try.)
+        if !(length2 > 0.0 && length2.is_finite()) {
+            return (best, false);
+        }
+        let length = length2.sqrt();
+        let numerator = d.dot(t) - ha.dot(d.abs()) - hb.dot(combine(d, &m).abs());
+        let gap = f64::from(numerator / length);
+        // |m̂ᵀd| is off by 16u|d|₁ per entry, the dot products by 3u of their terms: the
+        // module's 64u bound per unit of direction, and the division and root's 8u.
+        let gap = gap - slack - 8.0 * U * gap.abs();
+        let best = best.max(gap);
+        let short = gap + slack < CONVERGED * f64::from(length);
+        (best, short && best < enough)
+    }
+}
+
+/// Whether two f32 boxes are certainly disjoint (B posed in A's model frame by `b_to_a`),
+/// by the 15 separating axes, with `guard` as in [`super::pair::BoxPair::disjoint`]:
+/// `true` only where that test also reports them disjoint, up to the rounding bounds of
+/// the module documentation. `R` is `f32` (see [`Real::to_f32`], exact there).
+#[inline(always)]
+pub(crate) fn disjoint<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose, guard: f64) -> bool {
+    F32Pair::new(a, b, b_to_a).disjoint(guard)
+}
+
+/// A lower bound on the distance between two f32 boxes (B posed in A's model frame by
+/// `b_to_a`) and the distance of their centres: the face-axis and direction terms of the
+/// f64 bound in f32, with their rounding taken off, stopping once the bound reaches
+/// `enough`. `None` where the f64 bound would re-orthonormalise the frames (boxes far
+/// apart relative to their size, `far(|offset|₁, Σ half-widths)`), and a third value
+/// `true` where the f64 bound would go on to the edge-edge axes: the caller then computes
+/// it.
+#[inline(always)]
+pub(crate) fn distance_lower_bound_until<R: Real>(
+    a: &Obb<R>,
+    b: &Obb<R>,
+    b_to_a: &Pose,
+    enough: f64,
+    far: impl Fn(f64, f64) -> bool,
+) -> Option<(f64, f64, bool)> {
+    let pair = F32Pair::new(a, b, b_to_a);
+    if far(pair.offset_norm1, pair.sum_a + pair.sum_b) {
+        return None;
+    }
+    let [t0, t1, t2] = pair.t64;
+    let centres = (t0 * t0 + t1 * t1 + t2 * t2).sqrt();
+    let (bound, edges) = pair.distance_lower_bound_until(enough);
+    Some((bound, centres, edges))
+}
