@@ -67,6 +67,16 @@ mod lanes {
         // (A read of the 16 bytes the reference covers.)
         unsafe { _mm_loadu_ps(v.as_ptr()) }
     }
+    /// Lane by lane, the larger (`b` where either is NaN).
+    #[inline(always)]
+    pub fn max(a: V, b: V) -> V {
+        unsafe { _mm_max_ps(a, b) }
+    }
+    /// Lane by lane, `a` clamped to `[-h, h]` (`h` non-negative; a NaN `a` gives `-h`).
+    #[inline(always)]
+    pub fn clamp(a: V, h: V) -> V {
+        unsafe { _mm_max_ps(_mm_min_ps(a, h), _mm_xor_ps(h, _mm_set1_ps(-0.0))) }
+    }
     /// The four lanes, in order.
     #[inline(always)]
     pub fn store(v: V) -> [f32; 4] {
@@ -155,6 +165,14 @@ mod lanes {
     #[inline(always)]
     pub fn store(v: V) -> [f32; 4] {
         v
+    }
+    #[inline(always)]
+    pub fn max(a: V, b: V) -> V {
+        zip(a, b, f32::max)
+    }
+    #[inline(always)]
+    pub fn clamp(a: V, h: V) -> V {
+        zip(a, h, |x, h| x.min(h).max(-h))
     }
     #[inline(always)]
     pub fn add(a: V, b: V) -> V {
@@ -269,11 +287,11 @@ impl F4 {
     fn lanes(self) -> [f32; 4] {
         lanes::store(self.0)
     }
-    /// Lane by lane, the larger (NaN ignored, as `f64::max` does).
+    /// Lane by lane, the larger (where a lane is NaN, either value: the callers take a
+    /// largest lane, which ignores NaN).
     #[inline(always)]
     fn max(self, o: F4) -> F4 {
-        let ([a, b, c, d], [e, f, g, h]) = (self.lanes(), o.lanes());
-        F4(lanes::load(&[a.max(e), b.max(f), c.max(g), d.max(h)]))
+        F4(lanes::max(self.0, o.0))
     }
     /// The largest of the three lanes, NaN ignored (as `f64::max` does).
     #[inline(always)]
@@ -281,21 +299,12 @@ impl F4 {
         let [x, y, z, _] = self.lanes();
         x.max(y).max(z)
     }
-    /// The point of the box `[-h, h]` nearest to each lane (NaN passes through, as in
-    /// the f64 `clamp_box`).
+    /// The point of the box `[-h, h]` nearest to the lanes (`h` non-negative). A NaN lane
+    /// (a damaged file) gives some point of the box: any direction between the points
+    /// gives a valid bound.
     #[inline(always)]
     fn clamp(self, h: F4) -> F4 {
-        let ([x, y, z, _], [hx, hy, hz, _]) = (self.lanes(), h.lanes());
-        let c = |v: f32, h: f32| {
-            if v > h {
-                h
-            } else if v < -h {
-                -h
-            } else {
-                v
-            }
-        };
-        F4::new(c(x, hx), c(y, hy), c(z, hz))
+        F4(lanes::clamp(self.0, h.0))
     }
     /// The dot product of the three lanes.
     #[inline(always)]
