@@ -101,6 +101,21 @@ fn arb_relative_pose() -> impl Strategy<Value = Pose> {
         .prop_map(|(a, b, c, x, y, z)| Pose::new(rotation(a, b, c), Vector3::new(x, y, z)).unwrap())
 }
 
+/// `o` as a builder would store it in f32, its centre moved by `shift` along every
+/// coordinate and, when `thin` is 0, 1 or 2, its half-width on that axis made 1e-7 (a
+/// sliver's leaf).
+fn stored_f32(o: &Obb<f64>, shift: f64, thin: usize) -> Obb<f32> {
+    let mut f = Obb::<f32> {
+        axes: o.axes.map(|r| r.map(|v| v as f32)),
+        center: o.center.map(|v| (v + shift) as f32),
+        half: o.half.map(|v| v as f32),
+    };
+    if let Some(h) = f.half.get_mut(thin) {
+        *h = 1e-7;
+    }
+    f
+}
+
 /// The 12 face triangles of a box, mapped by `pose`.
 fn surface(o: &Obb<f64>, pose: &Pose) -> Vec<Triangle> {
     let c: Vec<Vector3<f64>> = corners(o).iter().map(|p| pose.apply(p)).collect();
@@ -202,18 +217,7 @@ proptest! {
         a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose(),
         thin in 0..4usize, far in prop_oneof![Just(0.0), Just(1e3)],
     ) {
-        let narrow = |o: &Obb<f64>, shift: f64| {
-            let mut f = Obb::<f32> {
-                axes: o.axes.map(|r| r.map(|v| v as f32)),
-                center: o.center.map(|v| (v + shift) as f32),
-                half: o.half.map(|v| v as f32),
-            };
-            if let Some(h) = f.half.get_mut(thin) {
-                *h = 1e-7;
-            }
-            f
-        };
-        let (fa, fb) = (narrow(&a, far), narrow(&b, -far));
+        let (fa, fb) = (stored_f32(&a, far, thin), stored_f32(&b, -far, thin));
         let wide = |f: &Obb<f32>| {
             (
                 Matrix3::from_fn(|i, j| f64::from(f.axes[i][j])),
@@ -251,18 +255,7 @@ proptest! {
     fn f32_box_lower_bound_is_a_lower_bound_near_the_f64_one(
         a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose(), thin in 0..4usize,
     ) {
-        let narrow = |o: &Obb<f64>| {
-            let mut f = Obb::<f32> {
-                axes: o.axes.map(|r| r.map(|v| v as f32)),
-                center: o.center.map(|v| v as f32),
-                half: o.half.map(|v| v as f32),
-            };
-            if let Some(h) = f.half.get_mut(thin) {
-                *h = 1e-7;
-            }
-            f
-        };
-        let (fa, fb) = (narrow(&a), narrow(&b));
+        let (fa, fb) = (stored_f32(&a, 0.0, thin), stored_f32(&b, 0.0, thin));
         let widen = |f: &Obb<f32>| Obb::<f64> {
             axes: f.axes.map(|r| r.map(f64::from)),
             center: f.center.map(f64::from),
