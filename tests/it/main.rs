@@ -8,6 +8,7 @@ mod common;
 
 mod build_roundtrip;
 mod bv_pair;
+mod cad_work;
 mod cli;
 mod concurrency;
 mod contact_work;

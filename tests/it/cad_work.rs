@@ -1,0 +1,110 @@
+//! The work of queries between CAD parts of long thin triangles, pinned: ALSTOM_TEST4
+//! against itself and against anchor (`tests/fixtures/cad`, from CGAL's data meshes,
+//! normalised to unit bounding spheres), at the 24 poses of `obbtree poses random --count
+//! 24 --radius 1.6 --seed 7`, the peers benchmark's CAD poses. Slivers are where box tests
+//! cost most and prune least, so a change to the fit, the split or the box tests shows
+//! here first; a deliberate improvement updates the counts, with the before and after in
+//! its commit message.
+// Test code outside `#[test]` functions (helpers): a failure is a failed test.
+#![allow(clippy::expect_used)]
+
+use obbtree::build::{build, BuildOptions};
+use obbtree::format::ObbtFile;
+use obbtree::mesh::TriMesh;
+use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose, Work};
+
+fn part(name: &str) -> ObbtFile {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/cad")
+        .join(name);
+    let mesh = TriMesh::load(&path).expect("the fixture loads");
+    build(&mesh, &BuildOptions::default(), None).expect("builds")
+}
+
+/// Node pairs and triangle pairs of a sum of work.
+fn pairs(work: &[Work]) -> (u64, u64) {
+    let nodes = work.iter().map(|w| w.nodes_visited).sum();
+    let triangles = work.iter().map(|w| w.tri_contact + w.tri_separated).sum();
+    (nodes, triangles)
+}
+
+/// Per pair of parts: contacts, then (node pairs, triangle pairs) of all-pairs collision,
+/// first contact, exact distance and distance within 1%.
+type Pinned = (usize, (u64, u64), (u64, u64), (u64, u64), (u64, u64));
+
+fn run(a: &ObbtFile, b: &ObbtFile) -> Pinned {
+    let poses: Vec<(Pose, Pose)> = obbtree::generate::random_poses(24, 1.6, 7)
+        .expect("poses")
+        .into_iter()
+        .map(|[a, b]| (a, b))
+        .collect();
+    let mut pair = PairQuery::new(a, b).expect("one volume type");
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
+    let rel = DistanceOptions {
+        rel_err: 0.01,
+        ..DistanceOptions::default()
+    };
+    let (mut contacts, mut all, mut firsts, mut exact, mut within) =
+        (0, Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (k, (pa, pb)) in poses.iter().enumerate() {
+        let c = pair
+            .collide(pa, pb, &CollideOptions::default())
+            .expect("all");
+        let f = pair.collide(pa, pb, &first).expect("first");
+        let e = pair
+            .distance(pa, pb, &DistanceOptions::default())
+            .expect("exact");
+        let r = pair.distance(pa, pb, &rel).expect("rel_err");
+        // The answers agree with each other before their work is counted.
+        assert_eq!(c.colliding, f.colliding, "pose {k}: first contact");
+        assert_eq!(
+            c.colliding,
+            e.distance() == 0.0,
+            "pose {k}: distance 0 iff touching"
+        );
+        assert!(
+            r.distance() >= e.distance() && r.distance() <= 1.01 * e.distance(),
+            "pose {k}: {} against {}",
+            r.distance(),
+            e.distance()
+        );
+        contacts += c.pairs.len();
+        all.push(c.work);
+        firsts.push(f.work);
+        exact.push(e.work);
+        within.push(r.work);
+    }
+    (
+        contacts,
+        pairs(&all),
+        pairs(&firsts),
+        pairs(&exact),
+        pairs(&within),
+    )
+}
+
+#[test]
+fn cad_work_is_pinned() {
+    let (alstom, anchor) = (part("ALSTOM_TEST4.obj"), part("anchor.obj"));
+    let same = run(&alstom, &alstom);
+    let mixed = run(&alstom, &anchor);
+    assert_eq!(
+        same,
+        (180, (3_126, 356), (144, 2), (13_010, 1_041), (7_496, 192)),
+        "ALSTOM_TEST4 against itself"
+    );
+    assert_eq!(
+        mixed,
+        (
+            694,
+            (12_982, 1_366),
+            (819, 10),
+            (27_841, 2_609),
+            (22_325, 1_774)
+        ),
+        "ALSTOM_TEST4 against anchor"
+    );
+}
