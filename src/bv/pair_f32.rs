@@ -37,9 +37,10 @@ use nalgebra::Vector3;
 /// f32's unit roundoff, 2⁻²⁴.
 const U: f64 = f32::EPSILON as f64 / 2.0;
 
-/// Three f32 lanes and a fourth that stays 0, in one SSE register on x86-64 (SSE2 is part
-/// of that target's baseline, so no run-time detection is needed) and as an array
-/// elsewhere.
+/// Three f32 lanes and a fourth, in one SSE register on x86-64 (SSE2 is part of that
+/// target's baseline, so no run-time detection is needed) and as an array elsewhere. The
+/// fourth lane is 0 but in the rows of `rows_and_half`, and no result reads it. (The array
+/// version is checked by the same tests with its cfg swapped by hand.)
 #[derive(Clone, Copy, Debug)]
 struct F4(lanes::V);
 
