@@ -388,11 +388,10 @@ struct F32Pair {
     t64: [f64; 3],
     ha: F4,
     hb: F4,
-    /// `Σ ha`, `Σ hb`, `|t|₁` and the model-frame offset's `|·|₁`, in f64.
+    /// `Σ ha`, `Σ hb` and `|t|₁`, in f64.
     sum_a: f64,
     sum_b: f64,
     t_norm1: f64,
-    offset_norm1: f64,
 }
 
 impl F32Pair {
@@ -400,12 +399,20 @@ impl F32Pair {
     /// [`Real::to_f32`], exact there).
     #[inline(always)]
     fn new<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose) -> F32Pair {
+        F32Pair::with_offset(a, b, b_to_a, &centre_offset(a, b, b_to_a))
+    }
+
+    /// As [`F32Pair::new`], given [`centre_offset`].
+    #[inline(always)]
+    fn with_offset<R: Real>(
+        a: &Obb<R>,
+        b: &Obb<R>,
+        b_to_a: &Pose,
+        offset: &Vector3<f64>,
+    ) -> F32Pair {
         let (rows_a, ha) = rows_and_half(a);
         let (rows_b, hb) = rows_and_half(b);
-        // The centre offset in f64, then in A's box frame (exact f32 axes, widened).
-        let ca = Vector3::from(a.center_f64());
-        let cb = Vector3::from(b.center_f64());
-        let offset = b_to_a.apply(&cb) - ca;
+        // The centre offset in A's box frame (exact f32 axes, widened).
         let [a0, a1, a2] = a.axes_f64();
         let project = |[x, y, z]: [f64; 3]| x * offset.x + y * offset.y + z * offset.z;
         let t64 = [project(a0), project(a1), project(a2)];
@@ -426,10 +433,9 @@ impl F32Pair {
             t64,
             ha,
             hb,
-            sum_a: a.half_f64().iter().sum(),
-            sum_b: b.half_f64().iter().sum(),
+            sum_a: half_sum(a),
+            sum_b: half_sum(b),
             t_norm1: t0.abs() + t1.abs() + t2.abs(),
-            offset_norm1: offset.abs().sum(),
         }
     }
 
@@ -522,6 +528,18 @@ impl F32Pair {
     }
 }
 
+/// B's centre less A's, in A's model frame, in f64 (as the f64 tests compute it).
+#[inline(always)]
+fn centre_offset<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose) -> Vector3<f64> {
+    b_to_a.apply(&Vector3::from(b.center_f64())) - Vector3::from(a.center_f64())
+}
+
+/// A box's half-widths summed, in f64.
+#[inline(always)]
+fn half_sum<R: Real>(o: &Obb<R>) -> f64 {
+    o.half_f64().iter().sum()
+}
+
 /// Whether two f32 boxes are certainly disjoint (B posed in A's model frame by `b_to_a`),
 /// by the 15 separating axes, with `guard` as in [`super::pair::BoxPair::disjoint`]:
 /// `true` only where that test also reports them disjoint, up to the rounding bounds of
@@ -546,10 +564,12 @@ pub(crate) fn distance_lower_bound_until<R: Real>(
     enough: f64,
     far: impl Fn(f64, f64) -> bool,
 ) -> Option<(f64, f64, bool)> {
-    let pair = F32Pair::new(a, b, b_to_a);
-    if far(pair.offset_norm1, pair.sum_a + pair.sum_b) {
+    // Checked before anything is computed in f32: past it the caller computes in f64.
+    let offset = centre_offset(a, b, b_to_a);
+    if far(offset.abs().sum(), half_sum(a) + half_sum(b)) {
         return None;
     }
+    let pair = F32Pair::with_offset(a, b, b_to_a, &offset);
     let [t0, t1, t2] = pair.t64;
     let centres = (t0 * t0 + t1 * t1 + t2 * t2).sqrt();
     let (bound, edges) = pair.distance_lower_bound_until(enough);
