@@ -31,9 +31,9 @@ use obbtree::bv::BvKind;
 use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile, OpenError, VerifyError};
 use obbtree::query::{
-    batch, BatchError, BatchOptions, CollideOptions, CollideResult, DistanceOptions, PairQuery,
-    Pose, PoseBatch, PoseError, PoseFormat, QueryError, SpanOptions, ToleranceOptions, Witness,
-    Work,
+    batch, BatchError, BatchOptions, CollideOptions, CollideResult, DistanceOptions,
+    DistanceResult, PairQuery, Pose, PoseBatch, PoseError, PoseFormat, QueryError, SpanOptions,
+    SpanResult, ToleranceOptions, ToleranceResult, Witness, Work,
 };
 use obbtree::real::Precision;
 use obbtree::tree::Encoding;
@@ -533,6 +533,37 @@ fn witness(w: Option<&Witness>) -> ObbtreeWitness {
             tri_a: OBBTREE_NO_TRIANGLE,
             tri_b: OBBTREE_NO_TRIANGLE,
         },
+    }
+}
+
+// A query's result as C reads it, one conversion per kind for the single and batch calls.
+
+impl From<&DistanceResult> for ObbtreeDistanceResult {
+    fn from(r: &DistanceResult) -> ObbtreeDistanceResult {
+        ObbtreeDistanceResult {
+            found: r.closest.is_some(),
+            closest: witness(r.closest.as_ref()),
+            work: work(&r.work),
+        }
+    }
+}
+
+impl From<&ToleranceResult> for ObbtreeToleranceResult {
+    fn from(r: &ToleranceResult) -> ObbtreeToleranceResult {
+        ObbtreeToleranceResult {
+            closer: r.witness.is_some(),
+            witness: witness(r.witness.as_ref()),
+            work: work(&r.work),
+        }
+    }
+}
+
+impl From<&SpanResult> for ObbtreeSpanResult {
+    fn from(r: &SpanResult) -> ObbtreeSpanResult {
+        ObbtreeSpanResult {
+            farthest: witness(Some(&r.farthest)),
+            work: work(&r.work),
+        }
     }
 }
 
@@ -1052,11 +1083,7 @@ pub unsafe extern "C" fn obbtree_pair_distance(
         let options = distance_options(rel_err, abs_err, max_distance);
         // SAFETY: NULL or a live handle (the caller's contract).
         let result = unsafe { with_pair(pair, |s| Ok(s.query.distance(&pa, &pb, &options)?)) }?;
-        out.write(ObbtreeDistanceResult {
-            found: result.closest.is_some(),
-            closest: witness(result.closest.as_ref()),
-            work: work(&result.work),
-        });
+        out.write(ObbtreeDistanceResult::from(&result));
         Ok(())
     })
 }
@@ -1085,11 +1112,7 @@ pub unsafe extern "C" fn obbtree_pair_within(
         let options = ToleranceOptions::new(tolerance);
         // SAFETY: NULL or a live handle (the caller's contract).
         let result = unsafe { with_pair(pair, |s| Ok(s.query.within(&pa, &pb, &options)?)) }?;
-        out.write(ObbtreeToleranceResult {
-            closer: result.witness.is_some(),
-            witness: witness(result.witness.as_ref()),
-            work: work(&result.work),
-        });
+        out.write(ObbtreeToleranceResult::from(&result));
         Ok(())
     })
 }
@@ -1116,10 +1139,7 @@ pub unsafe extern "C" fn obbtree_pair_span(
         let options = SpanOptions::default();
         // SAFETY: NULL or a live handle (the caller's contract).
         let result = unsafe { with_pair(pair, |s| Ok(s.query.span(&pa, &pb, &options)?)) }?;
-        out.write(ObbtreeSpanResult {
-            farthest: witness(Some(&result.farthest)),
-            work: work(&result.work),
-        });
+        out.write(ObbtreeSpanResult::from(&result));
         Ok(())
     })
 }
@@ -1379,11 +1399,7 @@ pub unsafe extern "C" fn obbtree_distance_batch(
             threads,
             (results, results_len),
             |pair, pa, pb| pair.distance(pa, pb, &options),
-            |answer| ObbtreeDistanceResult {
-                found: answer.closest.is_some(),
-                closest: witness(answer.closest.as_ref()),
-                work: work(&answer.work),
-            },
+            |answer| ObbtreeDistanceResult::from(answer),
         )
     }
 }
@@ -1418,11 +1434,7 @@ pub unsafe extern "C" fn obbtree_within_batch(
             threads,
             (results, results_len),
             |pair, pa, pb| pair.within(pa, pb, &ToleranceOptions::new(tolerance)),
-            |answer| ObbtreeToleranceResult {
-                closer: answer.witness.is_some(),
-                witness: witness(answer.witness.as_ref()),
-                work: work(&answer.work),
-            },
+            |answer| ObbtreeToleranceResult::from(answer),
         )
     }
 }
@@ -1456,10 +1468,7 @@ pub unsafe extern "C" fn obbtree_span_batch(
             threads,
             (results, results_len),
             |pair, pa, pb| pair.span(pa, pb, &SpanOptions::default()),
-            |answer| ObbtreeSpanResult {
-                farthest: witness(Some(&answer.farthest)),
-                work: work(&answer.work),
-            },
+            |answer| ObbtreeSpanResult::from(answer),
         )
     }
 }
