@@ -20,7 +20,7 @@ mod seal;
 use obbtree::build::{
     build, BuildError, BuildOptions, SphereFit, DEFAULT_HULL_MAX_POINTS, DEFAULT_HULL_MIN_FACES,
 };
-use obbtree::bv::BvKind;
+use obbtree::bv::{BvKind, Layout};
 use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::mesh::TriMesh;
@@ -90,9 +90,16 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         h.wrapping_mul(31).wrapping_add(usize::from(b))
     });
     let bv = [BvKind::Obb, BvKind::Aabb, BvKind::Sphere][pick % 3];
+    let precision = [Precision::F32, Precision::F64][(pick / 3) % 2];
     let other = BuildOptions {
         bv,
-        precision: [Precision::F32, Precision::F64][(pick / 3) % 2],
+        precision,
+        // The compact layout exists for f32 boxes only.
+        layout: if (bv, precision) == (BvKind::Obb, Precision::F32) && (pick / 6912) % 2 == 1 {
+            Layout::Compact
+        } else {
+            Layout::Fast
+        },
         fit: [FitMethod::Hull, FitMethod::Triangles, FitMethod::Vertices][(pick / 6) % 3],
         leaf_size: [1, 2, 4, 128][(pick / 18) % 4],
         scale: [1.0, 1e-3, 1e3][(pick / 72) % 3],

@@ -8,7 +8,7 @@
 
 mod topdown;
 
-use crate::bv::{dispatch, BoundingVolume, BvKind, VolumeVisitor};
+use crate::bv::{dispatch, BoundingVolume, BvKind, Layout, LayoutError, NodeType, VolumeVisitor};
 use crate::fit::FitMethod;
 use crate::format::{self, ObbtFile, TreeImage, WriteError};
 use crate::mesh::TriMesh;
@@ -27,6 +27,10 @@ pub struct BuildOptions {
     pub bv: BvKind,
     /// The stored precision of vertices and volumes.
     pub precision: Precision,
+    /// How the nodes are laid out: [`Layout::Compact`] (f32 boxes only) stores quantised
+    /// boxes for smaller files and slower queries; pair it with
+    /// [`Layout::default_leaf_size`] unless you choose a leaf size.
+    pub layout: Layout,
     /// The covariance the node frames are fitted to.
     pub fit: FitMethod,
     /// With [`FitMethod::Hull`], the fewest faces a node needs for its frame to be fitted to
@@ -70,6 +74,7 @@ impl Default for BuildOptions {
         BuildOptions {
             bv: BvKind::Obb,
             precision: Precision::F32,
+            layout: Layout::Fast,
             fit: FitMethod::Hull,
             hull_min_faces: DEFAULT_HULL_MIN_FACES,
             hull_max_points: DEFAULT_HULL_MAX_POINTS,
@@ -169,7 +174,17 @@ impl BuildOptions {
         if self.sphere_fit == SphereFit::Minimal && self.bv != BvKind::Sphere {
             return Err(BuildError::SphereFit(self.bv));
         }
+        self.node_type()?;
         Ok(())
+    }
+
+    /// The node type the options ask for.
+    ///
+    /// # Errors
+    ///
+    /// [`BuildError::Layout`] for a layout the volume and precision do not have.
+    pub fn node_type(&self) -> Result<NodeType, BuildError> {
+        Ok(NodeType::new(self.bv, self.precision, self.layout)?)
     }
 }
 
@@ -189,6 +204,9 @@ pub enum BuildError {
     /// `scale` is not a finite number greater than 0.
     #[error("scale {0} is not a finite number greater than 0 (--scale)")]
     Scale(f64),
+    /// The compact layout asked for a tree other than f32 oriented boxes.
+    #[error(transparent)]
+    Layout(#[from] LayoutError),
     /// Minimal spheres asked for a tree of another volume type.
     #[error("--sphere-fit minimal applies to sphere trees, not to {} trees (--bv sphere)", .0.name())]
     SphereFit(BvKind),
@@ -301,7 +319,7 @@ pub fn build(
         options,
         progress,
     };
-    dispatch(options.bv, options.precision, visitor)
+    dispatch(options.node_type()?, visitor)
 }
 
 fn build_as<B: BoundingVolume>(

@@ -7,12 +7,14 @@
 
 mod aabb;
 mod ball;
+mod compact;
 mod obb;
 pub mod pair;
 mod pair_f32;
 mod sphere;
 
 pub use aabb::Aabb;
+pub use compact::CompactObb;
 pub use obb::Obb;
 pub use sphere::Sphere;
 
@@ -23,24 +25,24 @@ use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use zerocopy::{FromBytes, Immutable, KnownLayout};
 
-/// Generic code run on a volume type chosen at run time, from a ([`BvKind`],
-/// [`Precision`]) pair read from a header or an option: the one dispatch idiom of the
-/// crate. [`dispatch`] holds the one match over the combinations, so adding a volume type
-/// means adding its arms there and its [`BvKind`].
+/// Generic code run on a node type chosen at run time, from a [`NodeType`] read from a
+/// header or made from options: the one dispatch idiom of the crate. [`dispatch`] holds the
+/// one match over the node types, so adding one means adding its arm there.
 pub trait VolumeVisitor {
     /// What the visit returns.
     type Output;
-    /// Called once, with `B` the stored volume type (and through it the precision).
+    /// Called once, with `B` the stored volume type (and through it the precision and
+    /// layout).
     fn visit<B: BoundingVolume>(self) -> Self::Output;
 }
 
-/// Runs `visitor` with the volume type of `kind` stored at `precision` (static dispatch:
-/// one match here, then monomorphised code).
+/// Runs `visitor` with the volume type `node` stores (static dispatch: one match here, then
+/// monomorphised code).
 ///
 /// # Examples
 ///
 /// ```
-/// use obbtree::bv::{dispatch, BoundingVolume, BvKind, VolumeVisitor};
+/// use obbtree::bv::{dispatch, BoundingVolume, BvKind, Layout, NodeType, VolumeVisitor};
 /// use obbtree::real::Precision;
 ///
 /// /// The size of one stored volume.
@@ -52,19 +54,158 @@ pub trait VolumeVisitor {
 ///     }
 /// }
 ///
-/// let f32_box = dispatch(BvKind::Obb, Precision::F32, VolumeSize);
-/// let f64_box = dispatch(BvKind::Obb, Precision::F64, VolumeSize);
+/// let f32_box = dispatch(NodeType::plain(BvKind::Obb, Precision::F32), VolumeSize);
+/// let f64_box = dispatch(NodeType::plain(BvKind::Obb, Precision::F64), VolumeSize);
 /// assert_eq!(f64_box, 2 * f32_box);
+/// let compact = NodeType::new(BvKind::Obb, Precision::F32, Layout::Compact)?;
+/// assert!(dispatch(compact, VolumeSize) < f32_box / 2);
+/// # Ok::<(), obbtree::bv::LayoutError>(())
 /// ```
-pub fn dispatch<V: VolumeVisitor>(kind: BvKind, precision: Precision, visitor: V) -> V::Output {
-    match (kind, precision) {
-        (BvKind::Obb, Precision::F32) => visitor.visit::<Obb<f32>>(),
-        (BvKind::Obb, Precision::F64) => visitor.visit::<Obb<f64>>(),
-        (BvKind::Aabb, Precision::F32) => visitor.visit::<Aabb<f32>>(),
-        (BvKind::Aabb, Precision::F64) => visitor.visit::<Aabb<f64>>(),
-        (BvKind::Sphere, Precision::F32) => visitor.visit::<Sphere<f32>>(),
-        (BvKind::Sphere, Precision::F64) => visitor.visit::<Sphere<f64>>(),
+pub fn dispatch<V: VolumeVisitor>(node: NodeType, visitor: V) -> V::Output {
+    match (node.layout, node.bv, node.precision) {
+        // `NodeType::new` admits the compact layout for f32 boxes only.
+        (Layout::Compact, _, _) => visitor.visit::<CompactObb>(),
+        (Layout::Fast, BvKind::Obb, Precision::F32) => visitor.visit::<Obb<f32>>(),
+        (Layout::Fast, BvKind::Obb, Precision::F64) => visitor.visit::<Obb<f64>>(),
+        (Layout::Fast, BvKind::Aabb, Precision::F32) => visitor.visit::<Aabb<f32>>(),
+        (Layout::Fast, BvKind::Aabb, Precision::F64) => visitor.visit::<Aabb<f64>>(),
+        (Layout::Fast, BvKind::Sphere, Precision::F32) => visitor.visit::<Sphere<f32>>(),
+        (Layout::Fast, BvKind::Sphere, Precision::F64) => visitor.visit::<Sphere<f64>>(),
     }
+}
+
+/// How a tree's node records are laid out, as written in the file header.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Layout {
+    /// Each volume's scalars as they are: the fastest to query.
+    #[default]
+    Fast,
+    /// Quantised boxes ([`CompactObb`], 32-byte nodes instead of 64), built with two faces
+    /// per leaf by default ([`Layout::default_leaf_size`]): under half the bytes of a fast
+    /// f32 tree, for slower queries. f32 oriented boxes only.
+    Compact,
+}
+
+impl Layout {
+    /// Both layouts, default first.
+    pub const ALL: [Layout; 2] = [Layout::Fast, Layout::Compact];
+
+    /// The header tag (0, 1).
+    pub fn tag(self) -> u8 {
+        match self {
+            Layout::Fast => 0,
+            Layout::Compact => 1,
+        }
+    }
+
+    /// Inverse of [`Layout::tag`].
+    pub fn from_tag(tag: u8) -> Option<Layout> {
+        Layout::ALL.into_iter().find(|l| l.tag() == tag)
+    }
+
+    /// `"fast"` or `"compact"`, as used by the CLI.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Fast => "fast",
+            Layout::Compact => "compact",
+        }
+    }
+
+    /// Inverse of [`Layout::name`].
+    pub fn from_name(name: &str) -> Option<Layout> {
+        Layout::ALL.into_iter().find(|l| l.name() == name)
+    }
+
+    /// The leaf size a build uses when none is asked for: 1 for the fast layout; 2 for the
+    /// compact one, where leaves of two faces halve the nodes for a few more triangle tests.
+    pub fn default_leaf_size(self) -> u32 {
+        match self {
+            Layout::Fast => 1,
+            Layout::Compact => 2,
+        }
+    }
+}
+
+/// What a tree's nodes store: the volume, its precision and the layout. Only combinations
+/// that exist can be made, so [`dispatch`] always has a type to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct NodeType {
+    bv: BvKind,
+    precision: Precision,
+    layout: Layout,
+}
+
+impl NodeType {
+    /// The node type of `bv` at `precision` in `layout`.
+    ///
+    /// # Errors
+    ///
+    /// [`LayoutError`] for the compact layout of anything but f32 oriented boxes.
+    pub fn new(bv: BvKind, precision: Precision, layout: Layout) -> Result<NodeType, LayoutError> {
+        if layout == Layout::Compact && (bv, precision) != (BvKind::Obb, Precision::F32) {
+            return Err(LayoutError { bv, precision });
+        }
+        Ok(NodeType {
+            bv,
+            precision,
+            layout,
+        })
+    }
+
+    /// The node type of `bv` at `precision` in the fast layout (every combination exists).
+    pub fn plain(bv: BvKind, precision: Precision) -> NodeType {
+        NodeType {
+            bv,
+            precision,
+            layout: Layout::Fast,
+        }
+    }
+
+    /// The stored volume.
+    pub fn bv(self) -> BvKind {
+        self.bv
+    }
+
+    /// The stored precision: of the vertices, and of the volumes' scalars (the centres of
+    /// compact boxes).
+    pub fn precision(self) -> Precision {
+        self.precision
+    }
+
+    /// The node layout.
+    pub fn layout(self) -> Layout {
+        self.layout
+    }
+}
+
+/// `"obb f32"`, or `"obb f32 compact"` for the compact layout: how messages name a tree.
+impl std::fmt::Display for NodeType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}", self.bv.name(), self.precision.name())?;
+        if self.layout != Layout::Fast {
+            write!(f, " {}", self.layout.name())?;
+        }
+        Ok(())
+    }
+}
+
+/// The node type volume `B` is stored as.
+pub fn node_type_of<B: BoundingVolume>() -> NodeType {
+    NodeType {
+        bv: B::KIND,
+        precision: <B::Real as Real>::PRECISION,
+        layout: B::NODE_LAYOUT,
+    }
+}
+
+/// A layout asked for a volume and precision it does not exist for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the compact layout stores f32 oriented boxes only, not {} {} trees (--bv obb --precision f32)", .bv.name(), .precision.name())]
+pub struct LayoutError {
+    /// The volume asked for.
+    pub bv: BvKind,
+    /// The precision asked for.
+    pub precision: Precision,
 }
 
 /// Which bounding volume a tree stores, as written in the file header.
@@ -144,6 +285,8 @@ pub trait BoundingVolume:
     type Real: Real;
     /// The header tag of this volume type.
     const KIND: BvKind;
+    /// The node layout this type is stored in.
+    const NODE_LAYOUT: Layout = Layout::Fast;
 
     /// The smallest volume of this type that contains every vertex of `faces`, given the
     /// fitted frame `axes` (orthonormal columns, greatest spread first; only the oriented box
@@ -272,7 +415,7 @@ pub trait BoundingVolume:
 ///
 /// `#[repr(C)]`: the volume's fields, then `packed` (u32, little-endian), then zero padding up
 /// to the scalar alignment (none for f32, 4 bytes for f64). Sizes: OBB 64 / 128 bytes (an f32
-/// node is one cache line), AABB 28 / 56, sphere 20 / 40 (f32 / f64).
+/// node is one cache line), AABB 28 / 56, sphere 20 / 40 (f32 / f64); a compact box 32.
 #[derive(Clone, Copy, Debug, FromBytes, KnownLayout, Immutable)]
 #[repr(C)]
 pub struct Node<B: BoundingVolume> {
@@ -322,6 +465,7 @@ const _: () = {
     assert!(size_of::<Node<Aabb<f64>>>() == 56);
     assert!(size_of::<Node<Sphere<f32>>>() == 20);
     assert!(size_of::<Node<Sphere<f64>>>() == 40);
+    assert!(size_of::<Node<CompactObb>>() == 32);
 };
 
 /// The error bound of `dot(axis, p)` in f64 for axis components of magnitude at most 1:

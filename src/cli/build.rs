@@ -5,7 +5,7 @@ use super::progress::with_progress;
 use super::{human_bytes, Failure, WithContext};
 use clap::{Args, ValueEnum};
 use obbtree::build::{build, BuildOptions, SphereFit};
-use obbtree::bv::BvKind;
+use obbtree::bv::{BvKind, Layout};
 use obbtree::fit::FitMethod;
 use obbtree::format::{remove_stale_temporaries, ObbtFile};
 use obbtree::mesh::TriMesh;
@@ -101,9 +101,15 @@ pub struct TreeArgs {
     #[arg(long, value_enum)]
     pub sphere_fit: Option<SphereFitArg>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
-    /// [default: 1].
+    /// [default: 1; 2 with --layout compact].
     #[arg(long, value_name = "N")]
     pub leaf_size: Option<u32>,
+    /// How nodes are stored: `fast` (plain boxes, the fastest queries) or `compact`
+    /// (quantised boxes, with two triangles per leaf unless --leaf-size says otherwise:
+    /// under half the file size of fast f32 trees, slower queries; f32 OBB trees only)
+    /// [default: fast].
+    #[arg(long, value_enum)]
+    pub layout: Option<LayoutArg>,
     /// Stored precision of vertices and volumes (queries always compute in f64)
     /// [default: f32].
     #[arg(long, value_enum)]
@@ -156,6 +162,15 @@ pub enum SphereFitArg {
     Minimal,
 }
 
+/// `--layout` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum LayoutArg {
+    /// Plain boxes: the fastest queries.
+    Fast,
+    /// Quantised boxes: the smallest files.
+    Compact,
+}
+
 /// `--precision` values.
 #[derive(ValueEnum, Clone, Copy, Debug)]
 pub enum PrecisionArg {
@@ -169,7 +184,12 @@ impl TreeArgs {
     /// The library options these flags stand for (defaults where absent).
     pub fn options(&self) -> BuildOptions {
         let default = BuildOptions::default();
+        let layout = self.layout.map_or(default.layout, |l| match l {
+            LayoutArg::Fast => Layout::Fast,
+            LayoutArg::Compact => Layout::Compact,
+        });
         BuildOptions {
+            layout,
             bv: self.bv.map_or(default.bv, |bv| match bv {
                 BvArg::Obb => BvKind::Obb,
                 BvArg::Aabb => BvKind::Aabb,
@@ -186,7 +206,7 @@ impl TreeArgs {
             }),
             hull_min_faces: self.hull_min_faces.unwrap_or(default.hull_min_faces),
             hull_max_points: self.hull_max_points.unwrap_or(default.hull_max_points),
-            leaf_size: self.leaf_size.unwrap_or(default.leaf_size),
+            leaf_size: self.leaf_size.unwrap_or(layout.default_leaf_size()),
             model_axes: self.model_axes.unwrap_or(default.model_axes),
             sphere_fit: self.sphere_fit.map_or(default.sphere_fit, |f| match f {
                 SphereFitArg::BoxCentre => SphereFit::BoxCentre,
@@ -207,6 +227,7 @@ impl TreeArgs {
             ("--sphere-fit", self.sphere_fit.is_some()),
             ("--leaf-size", self.leaf_size.is_some()),
             ("--precision", self.precision.is_some()),
+            ("--layout", self.layout.is_some()),
         ]
         .into_iter()
         .filter_map(|(name, given)| given.then_some(name))
@@ -274,13 +295,12 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     if !args.quiet {
         let info = file.info();
         eprintln!(
-            "built {}: {} triangles, {} nodes, depth {} ({} {}, {} fit, leaf size {}), {} in {:.2} s",
+            "built {}: {} triangles, {} nodes, depth {} ({}, {} fit, leaf size {}), {} in {:.2} s",
             args.output.display(),
             info.triangles,
             info.nodes,
             info.stats.shape.depth,
-            info.bv.name(),
-            info.precision.name(),
+            file.node_type(),
             info.fit.name(),
             info.leaf_size,
             human_bytes(info.file_bytes),

@@ -137,9 +137,10 @@ fn print_text(name: &str, info: &Info) -> Result<(), Failure> {
         info.stats.shape.depth
     )?;
     out!(
-        "  built with     --bv {} --precision {} --fit {} --leaf-size {} ({} encoding)",
+        "  built with     --bv {} --precision {} --layout {} --fit {} --leaf-size {} ({} encoding)",
         info.bv.name(),
         info.precision.name(),
+        info.layout.name(),
         info.fit.name(),
         info.leaf_size,
         info.encoding.name()

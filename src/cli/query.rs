@@ -204,8 +204,18 @@ fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
             let given = options.precision.name().into();
             return Err(conflict("--precision", given, info.precision.name()));
         }
+        if options.layout != info.layout && tree.layout.is_some() {
+            let given = options.layout.name().into();
+            return Err(conflict("--layout", given, info.layout.name()));
+        }
         options.bv = info.bv;
         options.precision = info.precision;
+        if options.layout != info.layout {
+            options.layout = info.layout;
+            if tree.leaf_size.is_none() {
+                options.leaf_size = info.layout.default_leaf_size();
+            }
+        }
     }
     Ok((
         open_input(&inputs.a, &options)?,

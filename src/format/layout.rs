@@ -14,12 +14,15 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 pub const SIGNATURE: [u8; 8] = [0x89, b'O', b'B', b'T', b'\r', b'\n', 0x1a, b'\n'];
 /// Major version written and read: a reader refuses any other major version.
 pub const VERSION_MAJOR: u16 = 1;
-/// Newest minor version this crate reads and writes: 1 (1.1 added the optional `placement`
-/// section). Readers accept any minor version of their major version. Writers write the
-/// lowest minor version that defines every section a file holds
-/// ([`SectionKind::minor_version`]), so a file without a placement is a 1.0 file, byte for
-/// byte what a 1.0 writer wrote.
-pub const VERSION_MINOR: u16 = 1;
+/// Newest minor version this crate reads and writes: 2 (1.1 added the optional `placement`
+/// section, 1.2 the compact node layout). Readers accept any minor version of their major
+/// version. Writers write the lowest minor version that defines everything a file holds
+/// ([`SectionKind::minor_version`], [`LAYOUT_MINOR_VERSION`]), so a fast-layout file
+/// without a placement is a 1.0 file, byte for byte what a 1.0 writer wrote.
+pub const VERSION_MINOR: u16 = 2;
+/// The minor version that defined the header's `layout` field (and the compact layout): a
+/// file in the compact layout is at least this version.
+pub const LAYOUT_MINOR_VERSION: u16 = 2;
 /// Every section starts at a multiple of this many bytes (a cache line), and the file length
 /// is a multiple of it too.
 pub const SECTION_ALIGN: u64 = 64;
@@ -136,8 +139,10 @@ record! {
         pub degenerate_triangles: U32,
         /// Most faces in one leaf.
         pub max_leaf_faces: U32,
+        /// Node layout tag (1.2): 0 fast, 1 compact; 0 in older files.
+        pub layout: u8,
         /// Zero.
-        pub reserved0: U32,
+        pub reserved0: [u8; 3],
         /// Componentwise minimum of the stored vertices.
         pub bounds_min: [F64; 3],
         /// Componentwise maximum of the stored vertices.

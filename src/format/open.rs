@@ -7,10 +7,12 @@ use super::layout::{
     ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, MAX_SECTIONS, PLACEMENT_STRIDE, SECTION_ALIGN,
     SIGNATURE, VERSION_MAJOR,
 };
-use crate::bv::{dispatch, BoundingVolume, BvKind, Node, VolumeVisitor};
+use crate::bv::{
+    dispatch, node_type_of, BoundingVolume, BvKind, Layout, Node, NodeType, VolumeVisitor,
+};
 use crate::fit::FitMethod;
 use crate::placement::Placement;
-use crate::real::{Precision, Real};
+use crate::real::Precision;
 use crate::stats::{level_stats, LevelStats, TreeShape, TreeStats};
 use crate::tree::{Encoding, NodeDefect, TreeView, VARIABLE_MAX_LEAF_FACES};
 use std::ops::Range;
@@ -46,6 +48,8 @@ struct Meta {
     /// Everything the header and directory say, with the placement record decoded
     /// (identity without one).
     info: Info,
+    /// The node type, a combination `NodeType::new` accepts.
+    node: NodeType,
     /// Byte ranges of the four required sections, in [`SectionKind::REQUIRED`] order.
     required: [Range<usize>; 4],
 }
@@ -98,6 +102,8 @@ pub struct Info {
     pub bv: BvKind,
     /// Stored precision.
     pub precision: Precision,
+    /// Node layout (fast before format 1.2).
+    pub layout: Layout,
     /// Fit method the tree was built with.
     pub fit: FitMethod,
     /// Packed reference encoding.
@@ -141,6 +147,7 @@ impl Info {
             "degenerate_triangles": self.stats.degenerate_triangles,
             "bv": self.bv.name(),
             "precision": self.precision.name(),
+            "layout": self.layout.name(),
             "fit": self.fit.name(),
             "leaf_size": self.leaf_size,
             "encoding": self.encoding.name(),
@@ -162,8 +169,8 @@ pub trait TreeVisitor {
     fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output;
 }
 
-/// The stride of one node record of a given volume and precision (at most 128 bytes).
-fn node_size(bv: BvKind, precision: Precision) -> usize {
+/// The stride of one node record of a given type (at most 128 bytes).
+fn node_size(node: NodeType) -> usize {
     struct NodeSize;
     impl VolumeVisitor for NodeSize {
         type Output = usize;
@@ -171,7 +178,7 @@ fn node_size(bv: BvKind, precision: Precision) -> usize {
             Node::<B>::SIZE
         }
     }
-    dispatch(bv, precision, NodeSize)
+    dispatch(node, NodeSize)
 }
 
 /// [`SECTION_ALIGN`] as a `usize`, for checking a buffer's address.
@@ -310,6 +317,16 @@ impl ObbtFile {
         self.meta.info.precision
     }
 
+    /// The node layout stored.
+    pub fn layout(&self) -> Layout {
+        self.meta.info.layout
+    }
+
+    /// What the nodes store: volume, precision and layout, checked on open.
+    pub fn node_type(&self) -> NodeType {
+        self.meta.node
+    }
+
     /// How the stored coordinates were made from the input mesh's: `stored = scale · input +
     /// offset` ([`Placement::IDENTITY`] when the file has no `placement` section). Decoded on
     /// open, unverified: [`ObbtFile::verify`] checks that it is finite with a scale above 0.
@@ -421,11 +438,12 @@ impl ObbtFile {
     /// # }
     /// ```
     pub fn view<B: BoundingVolume>(&self) -> Result<TreeView<'_, B>, FormatError> {
-        let (bv, precision) = (self.bv_kind(), self.precision());
-        if B::KIND != bv || <B::Real as Real>::PRECISION != precision {
+        let found = self.node_type();
+        let requested = node_type_of::<B>();
+        if found != requested {
             return Err(FormatError::WrongType {
-                found: format!("{} {}", bv.name(), precision.name()),
-                requested: format!("{} {}", B::KIND.name(), <B::Real as Real>::PRECISION.name()),
+                found: found.to_string(),
+                requested: requested.to_string(),
             });
         }
         let bytes = self.bytes();
@@ -504,7 +522,7 @@ impl ObbtFile {
             }
         }
         let file = self;
-        dispatch(self.bv_kind(), self.precision(), Typed { file, visitor })
+        dispatch(self.node_type(), Typed { file, visitor })
     }
 
     fn from_backing(backing: Backing) -> Result<ObbtFile, FormatError> {
@@ -581,6 +599,9 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
         Encoding::from_tag(header.encoding).ok_or_else(|| unknown(at.encoding, header.encoding))?;
     let fit = FitMethod::from_tag(header.fit_method)
         .ok_or_else(|| unknown(at.fit_method, header.fit_method))?;
+    let layout =
+        Layout::from_tag(header.layout).ok_or_else(|| unknown(at.layout, header.layout))?;
+    let node = NodeType::new(bv, precision, layout).map_err(|e| field(at.layout, e.to_string()))?;
     let leaf_size = u32::from(header.leaf_size.get());
     if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&leaf_size) {
         return Err(field(
@@ -597,7 +618,7 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
             return Err(field(count, "is zero"));
         }
     }
-    if header.reserved0.get() != 0 || header.reserved1 != [0; 12] {
+    if header.reserved0 != [0; 3] || header.reserved1 != [0; 12] {
         // One message for both reserved fields, at the first.
         let reserved = Field {
             name: "reserved",
@@ -613,7 +634,7 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
             SectionKind::SourceIds => (u64::from(header.triangles.get()), 4),
             SectionKind::Nodes => (
                 u64::from(header.nodes.get()),
-                u32::try_from(node_size(bv, precision)).unwrap_or(u32::MAX),
+                u32::try_from(node_size(node)).unwrap_or(u32::MAX),
             ),
             SectionKind::Placement => (1, PLACEMENT_STRIDE),
         }
@@ -754,6 +775,7 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
         version: (major, minor),
         bv,
         precision,
+        layout,
         fit,
         encoding,
         leaf_size,
@@ -767,6 +789,7 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
     };
     Ok(Meta {
         info,
+        node,
         required: ranges,
     })
 }

@@ -3,10 +3,11 @@
 use super::aligned::AlignedBytes;
 use super::layout::{
     align_up, header_crc, vertex_stride, Header, PlacementRecord, SectionEntry, SectionKind,
-    ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, PLACEMENT_STRIDE, SIGNATURE, VERSION_MAJOR,
+    ENTRY_SIZE, FLAG_REQUIRED, HEADER_SIZE, LAYOUT_MINOR_VERSION, PLACEMENT_STRIDE, SIGNATURE,
+    VERSION_MAJOR,
 };
 use super::open::ObbtFile;
-use crate::bv::{BoundingVolume, Node};
+use crate::bv::{BoundingVolume, Layout, Node};
 use crate::fit::FitMethod;
 use crate::placement::Placement;
 use crate::real::{Precision, Real};
@@ -203,10 +204,11 @@ pub(crate) fn serialize<B: BoundingVolume>(tree: &TreeImage<B>) -> Result<ObbtFi
     let mut header = Header {
         signature: SIGNATURE,
         version_major: VERSION_MAJOR.into(),
-        // The lowest minor version that defines every section written.
+        // The lowest minor version that defines every section and the layout written.
         version_minor: sections
             .iter()
             .map(|&(kind, ..)| kind.minor_version())
+            .chain((B::NODE_LAYOUT != Layout::Fast).then_some(LAYOUT_MINOR_VERSION))
             .max()
             .unwrap_or_default()
             .into(),
@@ -227,7 +229,8 @@ pub(crate) fn serialize<B: BoundingVolume>(tree: &TreeImage<B>) -> Result<ObbtFi
         depth: s.shape.depth.into(),
         degenerate_triangles: s.degenerate_triangles.into(),
         max_leaf_faces: s.shape.max_leaf_faces.into(),
-        reserved0: 0.into(),
+        layout: B::NODE_LAYOUT.tag(),
+        reserved0: [0; 3],
         bounds_min: s.bounds_min.map(Into::into),
         bounds_max: s.bounds_max.map(Into::into),
         reserved1: [0; 12],

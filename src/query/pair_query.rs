@@ -83,16 +83,16 @@ impl<'f> PairQuery<'f> {
         b: &'f ObbtFile,
         context: QueryContext,
     ) -> Result<PairQuery<'f>, QueryError> {
-        if (a.bv_kind(), a.precision()) != (b.bv_kind(), b.precision()) {
+        if a.node_type() != b.node_type() {
             return Err(QueryError::MismatchedTrees {
-                a: format!("{} {}", a.bv_kind().name(), a.precision().name()),
-                b: format!("{} {}", b.bv_kind().name(), b.precision().name()),
+                a: a.node_type().to_string(),
+                b: b.node_type().to_string(),
             });
         }
         Ok(PairQuery {
             a,
             b,
-            trees: dispatch(a.bv_kind(), a.precision(), Typing { a, b })?,
+            trees: dispatch(a.node_type(), Typing { a, b })?,
             context,
         })
     }

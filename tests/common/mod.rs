@@ -96,6 +96,14 @@ pub fn all_options() -> Vec<obbtree::build::BuildOptions> {
             }
         }
     }
+    // Quantised boxes, at the compact layout's own leaf size and at 1.
+    for leaf_size in [1, obbtree::bv::Layout::Compact.default_leaf_size()] {
+        out.push(BuildOptions {
+            layout: obbtree::bv::Layout::Compact,
+            leaf_size,
+            ..BuildOptions::default()
+        });
+    }
     // Spheres centred on their smallest ball: another centre, the same guarantees.
     for precision in Precision::ALL {
         out.push(BuildOptions {
@@ -238,5 +246,5 @@ pub fn with_views<V: ViewsVisitor>(
             self.visitor.visit(&a, &b)
         }
     }
-    obbtree::bv::dispatch(a.bv_kind(), a.precision(), Typed { a, b, visitor })
+    obbtree::bv::dispatch(a.node_type(), Typed { a, b, visitor })
 }

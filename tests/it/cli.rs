@@ -910,6 +910,7 @@ fn build_help_states_the_library_defaults() {
             "--model-axes",
             if defaults.model_axes { "yes" } else { "no" }.to_string(),
         ),
+        ("--layout", defaults.layout.name().to_string()),
     ] {
         // The flag's own entry (`--flag <VALUE>`), not a mention in another's text.
         let at = help
@@ -917,12 +918,20 @@ fn build_help_states_the_library_defaults() {
             .unwrap_or_else(|| panic!("{flag} in the help"));
         let rest = &help[at..];
         let end = rest.find("[default: ").expect("a stated default");
+        // `[default: V]`, or `[default: V; ...]` when another flag changes it.
         assert!(
-            rest[end..].starts_with(&format!("[default: {value}]")),
+            [']', ';']
+                .iter()
+                .any(|close| rest[end..].starts_with(&format!("[default: {value}{close}"))),
             "{flag}: {}",
             &rest[end..end + 20]
         );
     }
+    let compact = obbtree::bv::Layout::Compact.default_leaf_size();
+    assert!(
+        help.contains(&format!("{compact} with --layout compact]")),
+        "{help}"
+    );
 }
 
 #[test]

@@ -23,6 +23,7 @@ mod fuzz_corpus;
 mod hard_cases;
 mod hostile_cli;
 mod hostile_files;
+mod layouts;
 mod mesh_loaders;
 mod poses;
 mod queries;

@@ -161,6 +161,10 @@ typedef struct ObbtreeInfo {
    */
   const char *encoding_name;
   /**
+   * Node layout: `"fast"` or `"compact"` (quantised boxes; static string).
+   */
+  const char *layout_name;
+  /**
    * Triangle count.
    */
   uint32_t triangles;

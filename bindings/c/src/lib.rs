@@ -27,7 +27,7 @@
     clippy::undocumented_unsafe_blocks
 )]
 
-use obbtree::bv::BvKind;
+use obbtree::bv::{BvKind, Layout};
 use obbtree::fit::FitMethod;
 use obbtree::format::{AlignedBytes, ObbtFile, OpenError, VerifyError};
 use obbtree::query::{
@@ -158,6 +158,8 @@ pub struct ObbtreeInfo {
     pub fit_name: *const c_char,
     /// Node encoding: `"binary"` or `"variable"` (static string).
     pub encoding_name: *const c_char,
+    /// Node layout: `"fast"` or `"compact"` (quantised boxes; static string).
+    pub layout_name: *const c_char,
     /// Triangle count.
     pub triangles: u32,
     /// Vertex count.
@@ -597,6 +599,13 @@ fn encoding_name(encoding: Encoding) -> &'static CStr {
     }
 }
 
+fn layout_name(layout: Layout) -> &'static CStr {
+    match layout {
+        Layout::Fast => c"fast",
+        Layout::Compact => c"compact",
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Library, errors
 // ---------------------------------------------------------------------------------------
@@ -788,6 +797,7 @@ pub unsafe extern "C" fn obbtree_info(
             precision_name: precision_name.as_ptr(),
             fit_name: fit_name(info.fit).as_ptr(),
             encoding_name: encoding_name(info.encoding).as_ptr(),
+            layout_name: layout_name(info.layout).as_ptr(),
             triangles: info.triangles,
             vertices: info.vertices,
             nodes: info.nodes,

@@ -103,7 +103,8 @@ def build(
     *,
     bv: str = "obb",
     precision: str = "f32",
-    leaf_size: int = 1,
+    layout: str = "fast",
+    leaf_size: Optional[int] = None,
     scale: float = 1.0,
     center: bool = False,
     fit: str = "hull",
@@ -127,8 +128,9 @@ def build(
     ``.obbt`` file is replaced only with ``force=True``.
 
     Options (those of ``obbtree build``): ``bv`` "obb", "aabb" or "sphere"; ``precision``
-    "f32" or "f64" (stored vertices and volumes; queries compute in f64); ``leaf_size``
-    1 to 128 triangles per leaf; ``scale`` multiplies every coordinate before storing
+    "f32" or "f64" (stored vertices and volumes; queries compute in f64); ``layout``
+    "fast" or "compact" (quantised f32 boxes: under half the file size, slower queries);
+    ``leaf_size`` 1 to 128 triangles per leaf (default 1, or 2 for the compact layout); ``scale`` multiplies every coordinate before storing
     (0.001: millimetres to metres); ``center`` moves the bounding-box centre to the
     origin (both recorded in ``info["placement"]``; queries work in stored units);
     ``fit`` "hull", "triangles" or "vertices"; ``hull_min_faces``, ``hull_max_points``,
@@ -142,6 +144,7 @@ def build(
         out=None if out is None else os.fspath(out),
         bv=bv,
         precision=precision,
+        layout=layout,
         fit=fit,
         leaf_size=leaf_size,
         scale=scale,

@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 /// The native half of `obbtree.build` (which documents it): builds from a mesh file, or
 /// from (n, 3) float64 vertices and (m, 3) int64 faces.
 #[pyfunction]
-#[pyo3(signature = (mesh_path, vertices, faces, out, bv, precision, fit, leaf_size, scale, center, hull_min_faces, hull_max_points, model_axes, sphere_fit, force))]
+#[pyo3(signature = (mesh_path, vertices, faces, out, bv, precision, layout, fit, leaf_size, scale, center, hull_min_faces, hull_max_points, model_axes, sphere_fit, force))]
 #[allow(clippy::too_many_arguments)]
 fn _build(
     py: Python<'_>,
@@ -27,8 +27,9 @@ fn _build(
     out: Option<std::path::PathBuf>,
     bv: &str,
     precision: &str,
+    layout: &str,
     fit: &str,
-    leaf_size: u32,
+    leaf_size: Option<u32>,
     scale: f64,
     center: bool,
     hull_min_faces: Option<u32>,
@@ -40,6 +41,7 @@ fn _build(
     let options = tree::build_options(
         bv,
         precision,
+        layout,
         fit,
         leaf_size,
         scale,

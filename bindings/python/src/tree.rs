@@ -5,7 +5,7 @@ use crate::json::to_python;
 use numpy::ndarray::ArrayView2;
 use numpy::PyArray2;
 use obbtree::build::{build as build_tree, BuildOptions, SphereFit};
-use obbtree::bv::BvKind;
+use obbtree::bv::{BvKind, Layout};
 use obbtree::fit::FitMethod;
 use obbtree::format::layout::SectionKind;
 use obbtree::format::ObbtFile;
@@ -303,8 +303,9 @@ fn choice<T: Copy>(what: &str, given: &str, options: &[(&str, T)]) -> Result<T, 
 pub fn build_options(
     bv: &str,
     precision: &str,
+    layout: &str,
     fit: &str,
-    leaf_size: u32,
+    leaf_size: Option<u32>,
     scale: f64,
     center: bool,
     hull_min_faces: Option<u32>,
@@ -313,7 +314,13 @@ pub fn build_options(
     sphere_fit: &str,
 ) -> Result<BuildOptions, Failure> {
     let default = BuildOptions::default();
+    let layout = choice(
+        "layout",
+        layout,
+        &[("fast", Layout::Fast), ("compact", Layout::Compact)],
+    )?;
     let options = BuildOptions {
+        layout,
         bv: choice(
             "bv",
             bv,
@@ -345,7 +352,7 @@ pub fn build_options(
                 ("minimal", SphereFit::Minimal),
             ],
         )?,
-        leaf_size,
+        leaf_size: leaf_size.unwrap_or(layout.default_leaf_size()),
         scale,
         center,
         hull_min_faces: hull_min_faces.unwrap_or(default.hull_min_faces),
