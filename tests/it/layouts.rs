@@ -112,7 +112,9 @@ fn compact_layout_is_refused_where_it_does_not_exist() {
     // Trees of two layouts are not queried together.
     let fast = build(&cow, &BuildOptions::default(), None).expect("fast build");
     let small = build(&cow, &compact(), None).expect("compact build");
-    let error = PairQuery::new(&fast, &small).err().expect("mismatched");
+    let Err(error) = PairQuery::new(&fast, &small) else {
+        panic!("trees of two layouts were paired");
+    };
     assert!(
         matches!(error, QueryError::MismatchedTrees { .. }),
         "{error}"
@@ -132,9 +134,7 @@ fn open_refuses_an_unknown_layout_and_a_compact_f64_header() {
         let mut bytes = small.bytes().to_vec();
         bytes[offset] = value;
         seal(&mut bytes);
-        let error = ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes))
-            .err()
-            .expect("refused");
+        let error = ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes)).expect_err("refused");
         assert!(matches!(error, FormatError::HeaderField { .. }), "{error}");
         let message = error.to_string();
         assert!(
