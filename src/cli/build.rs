@@ -101,12 +101,12 @@ pub struct TreeArgs {
     #[arg(long, value_enum)]
     pub sphere_fit: Option<SphereFitArg>,
     /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
-    /// [default: 1; 2 with --layout compact].
+    /// [default: 1; 4 with --layout compact].
     #[arg(long, value_name = "N")]
     pub leaf_size: Option<u32>,
     /// How nodes are stored: `fast` (plain boxes, the fastest queries) or `compact`
-    /// (quantised boxes, with two triangles per leaf unless --leaf-size says otherwise:
-    /// under half the file size of fast f32 trees, slower queries; f32 OBB trees only)
+    /// (quantised boxes, with four triangles per leaf unless --leaf-size says otherwise:
+    /// under a third of the default file size, slower queries; f32 OBB trees only)
     /// [default: fast].
     #[arg(long, value_enum)]
     pub layout: Option<LayoutArg>,

@@ -1,13 +1,17 @@
-//! What accuracy costs in time: the choices that trade one for the other (the distance
-//! error allowed, tolerance queries, f32 or f64 storage, the fit, the leaf size), each
-//! measured by the time it takes and the error it actually incurs against an exact f64
-//! reference, on the sliding spheres and on any mesh against a turned copy of itself.
+//! What accuracy and size cost in time: the choices that trade one for the other (the
+//! distance error allowed, tolerance queries, f32 or f64 storage, the fit, the leaf size,
+//! the compact layout), each measured by the time it takes, the error it actually incurs
+//! against an exact f64 reference and the bytes its trees take, on the sliding spheres and
+//! on any mesh against a turned copy of itself.
 //!
 //! A choice is worth making when no other is both faster and more accurate: the Pareto
-//! front of each scene's (error, time) points ([`Trade::pareto`]).
+//! front of each scene's (error, time) points ([`Trade::pareto`]). Size is the third
+//! axis: the compact layout answers exactly, slower, from smaller files
+//! ([`Trade::bytes_per_triangle`]).
 
 use super::{median_time, turned_pair, ExperimentError, Size};
 use crate::build::{build, BuildOptions};
+use crate::bv::Layout;
 use crate::fit::FitMethod;
 use crate::format::ObbtFile;
 use crate::generate::{lat_long_sphere, PosePair, Rng};
@@ -106,14 +110,16 @@ pub struct Trade {
     pub error_max: f64,
     /// Mean volume tests per query.
     pub bv_tests: f64,
+    /// The bytes of both models' tree files per triangle they hold.
+    pub bytes_per_triangle: f64,
     /// Whether no other choice of the same scene and query is at least as fast and at
     /// least as accurate (by the largest error), and better in one.
     pub pareto: bool,
 }
 
 impl Trade {
-    /// A trade with nothing measured yet.
-    fn new(scene: &str, query: &'static str, choice: String) -> Trade {
+    /// A trade of trees of `bytes_per_triangle` with nothing measured yet.
+    fn new(scene: &str, query: &'static str, choice: String, bytes_per_triangle: f64) -> Trade {
         Trade {
             scene: scene.into(),
             query,
@@ -122,15 +128,17 @@ impl Trade {
             error_mean: 0.0,
             error_max: 0.0,
             bv_tests: 0.0,
+            bytes_per_triangle,
             pareto: false,
         }
     }
 }
 
-/// A tree choice: storage precision, fit and leaf size.
+/// A tree choice: storage precision, layout, fit and leaf size.
 #[derive(Clone, Copy, Debug)]
 struct TreeChoice {
     precision: Precision,
+    layout: Layout,
     fit: FitMethod,
     leaf_size: u32,
 }
@@ -138,6 +146,7 @@ struct TreeChoice {
 impl TreeChoice {
     const DEFAULT: TreeChoice = TreeChoice {
         precision: Precision::F32,
+        layout: Layout::Fast,
         fit: FitMethod::Hull,
         leaf_size: 1,
     };
@@ -145,10 +154,13 @@ impl TreeChoice {
     /// The flags that differ from the defaults.
     fn flags(self) -> Vec<String> {
         let mut flags = vec![self.precision.name().to_string()];
+        if self.layout != Layout::Fast {
+            flags.push(format!("--layout {}", self.layout.name()));
+        }
         if self.fit != FitMethod::Hull {
             flags.push(format!("--fit {}", self.fit.name()));
         }
-        if self.leaf_size != 1 {
+        if self.leaf_size != self.layout.default_leaf_size() {
             flags.push(format!("--leaf-size {}", self.leaf_size));
         }
         flags
@@ -157,6 +169,7 @@ impl TreeChoice {
     fn options(self) -> BuildOptions {
         BuildOptions {
             precision: self.precision,
+            layout: self.layout,
             fit: self.fit,
             leaf_size: self.leaf_size,
             ..BuildOptions::default()
@@ -164,13 +177,19 @@ impl TreeChoice {
     }
 }
 
-/// The tree choices measured: f32 and f64, the two other fits, and larger leaves.
+/// The tree choices measured: f32 and f64, the compact layout, the two other fits, and
+/// larger leaves.
 fn tree_choices() -> Vec<TreeChoice> {
     let d = TreeChoice::DEFAULT;
     vec![
         d,
         TreeChoice {
             precision: Precision::F64,
+            ..d
+        },
+        TreeChoice {
+            layout: Layout::Compact,
+            leaf_size: Layout::Compact.default_leaf_size(),
             ..d
         },
         TreeChoice {
@@ -256,8 +275,11 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
     let mut out = Vec::new();
     for choice in tree_choices() {
         let (a, b) = trees(scene, choice)?;
+        let bytes_per_triangle = (a.info().file_bytes + b.info().file_bytes) as f64
+            / (f64::from(a.info().triangles) + f64::from(b.info().triangles));
         let mut pair = PairQuery::new(&a, &b)?;
         let asks: &[Ask] = if matches!(choice.precision, Precision::F32)
+            && choice.layout == Layout::Fast
             && choice.fit == FitMethod::Hull
             && choice.leaf_size == 1
         {
@@ -267,7 +289,7 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
         };
         for &ask in asks {
             let choice = [choice.flags(), vec![ask.flag()]].concat().join(", ");
-            let mut trade = Trade::new(&scene.name, "distance", choice);
+            let mut trade = Trade::new(&scene.name, "distance", choice, bytes_per_triangle);
             for ([pa, pb], &d) in scene.apart.iter().zip(&distances) {
                 let ((found, tests), seconds) =
                     median_time(repeat, || -> Result<_, QueryError> {
@@ -298,7 +320,8 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
             finish(&mut trade, scene.apart.len());
             out.push(trade);
         }
-        let mut trade = Trade::new(&scene.name, "collision", choice.flags().join(", "));
+        let choice = choice.flags().join(", ");
+        let mut trade = Trade::new(&scene.name, "collision", choice, bytes_per_triangle);
         for ([pa, pb], expected) in scene.crossing.iter().zip(&contacts) {
             let ((found, tests), seconds) = median_time(repeat, || -> Result<_, QueryError> {
                 let r = pair.collide(pa, pb, &CollideOptions::default())?;

@@ -523,22 +523,36 @@ fn quick_accuracy_keeps_every_choice_within_its_promise() {
         out.push(field);
         out
     };
+    let mut bytes_per_triangle = std::collections::BTreeMap::new();
     let trades: Vec<(String, String, String, f64, f64, bool)> = text
         .lines()
         .skip(1)
         .map(|line| {
             let f = fields(line);
-            assert_eq!(f.len(), 8, "{line}");
+            assert_eq!(f.len(), 9, "{line}");
+            let bytes: f64 = f[7].parse().unwrap();
+            bytes_per_triangle.insert((f[0].clone(), f[1].clone(), f[2].clone()), bytes);
             (
                 f[0].clone(),
                 f[1].clone(),
                 f[2].clone(),
                 f[3].parse().unwrap(),
                 f[5].parse().unwrap(),
-                f[7] == "true",
+                f[8] == "true",
             )
         })
         .collect();
+    // The compact layout is measured on every scene and query, in under a third of the bytes.
+    for scene in ["cow", "spheres"] {
+        let of =
+            |choice: &str| bytes_per_triangle[&(scene.into(), "collision".into(), choice.into())];
+        let (fast, compact) = (of("f32"), of("f32, --layout compact"));
+        assert!(
+            compact < 0.5 * fast,
+            "{scene}: {compact} vs {fast} bytes per triangle"
+        );
+    }
+    assert!(dir.join("accuracy-size.svg").exists());
     let scenes: std::collections::BTreeSet<&str> = trades.iter().map(|t| t.0.as_str()).collect();
     assert_eq!(scenes.into_iter().collect::<Vec<_>>(), ["cow", "spheres"]);
     // f32 coordinates are within 6e-8 of the f64 ones: distances move by about that.

@@ -124,7 +124,8 @@ impl From<BuildError> for Failure {
             | BuildError::HullMinFaces(_)
             | BuildError::HullMaxPoints(_)
             | BuildError::Scale(_)
-            | BuildError::SphereFit(_) => Kind::Option,
+            | BuildError::SphereFit(_)
+            | BuildError::Layout(_) => Kind::Option,
             _ => Kind::Mesh,
         };
         Failure::new(kind, e.to_string())

@@ -133,7 +133,7 @@ use pyo3::types::IntoPyDict;
 impl Tree {
     /// What the tree holds, from its header alone: a dict with the keys of
     /// `obbtree info --json` (version, triangles, vertices, nodes, leaves, depth,
-    /// max_leaf_faces, degenerate_triangles, bv, precision, fit, leaf_size, encoding,
+    /// max_leaf_faces, degenerate_triangles, bv, precision, layout, fit, leaf_size, encoding,
     /// bounds, placement, file_bytes, bytes_per_triangle, sections).
     #[getter]
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -66,6 +66,31 @@ def test_build_returns_open_mapped_tree(tmp_path):
     assert obbtree.open(out).info == t.info
 
 
+def test_compact_layout_is_smaller_and_answers_alike(tmp_path, cow):
+    out = tmp_path / "cow-compact.obbt"
+    small = obbtree.build(str(COW_OBJ), str(out), layout="compact")
+    small.verify()
+    info = small.info
+    assert info["layout"] == "compact" and info["version"] == "1.2"
+    assert info["leaf_size"] == 4
+    assert cow.info["layout"] == "fast"
+    assert info["bytes_per_triangle"] < cow.info["bytes_per_triangle"] / 3
+    poses = random_poses(30, spread=0.5, seed=5)
+    fast_hits = obbtree.collide(cow, I, cow, poses)
+    small_hits = obbtree.collide(small, I, small, poses)
+    assert np.array_equal(fast_hits.contacts, small_hits.contacts)
+    assert fast_hits.contacts.sum() > 0
+    assert np.allclose(obbtree.distance(small, I, small, poses).distance,
+                       obbtree.distance(cow, I, cow, poses).distance, rtol=1e-12, atol=0)
+    # Trees of two layouts are not paired; a layout without f32 boxes is refused.
+    with pytest.raises(obbtree.Error, match="compact"):
+        obbtree.collide(cow, I, small, I)
+    with pytest.raises(obbtree.OptionError, match="compact layout"):
+        obbtree.build(str(COW_OBJ), layout="compact", precision="f64")
+    with pytest.raises(obbtree.OptionError, match="layout"):
+        obbtree.build(str(COW_OBJ), layout="tiny")
+
+
 def test_trimesh_input():
     trimesh = pytest.importorskip("trimesh", reason="trimesh is installed by scripts/test")
     mesh = trimesh.load(str(COW_OBJ), process=False, force="mesh")

@@ -390,3 +390,41 @@ impl TradeChart {
         }
     }
 }
+
+/// What size costs in time: for each scene and query, the time of every tree choice asked
+/// exactly against its trees' bytes per triangle, each point labelled with its choice (the
+/// answers are the exact ones, so only size and time differ).
+pub fn size_chart(trades: &[Trade], scenes: &[Workload]) -> Chart<'static> {
+    let mut all = Vec::new();
+    for (colour, (scene, query)) in scenes
+        .iter()
+        .flat_map(|scene| TRADE_CHARTS.iter().map(move |c| (scene, c.query)))
+        .enumerate()
+    {
+        let exact: Vec<&Trade> = trades
+            .iter()
+            .filter(|t| t.scene == scene.name && t.query == query && t.error_max == 0.0)
+            .collect();
+        all.push(Series {
+            name: format!("{} {query}", scene.name),
+            points: exact
+                .iter()
+                .map(|t| (t.bytes_per_triangle, t.seconds * 1e3))
+                .collect(),
+            line: false,
+            colour,
+            labels: exact
+                .iter()
+                .map(|t| t.choice.replace("--", "").replace(", exact", ""))
+                .collect(),
+        });
+    }
+    Chart {
+        title: "Size: time against the trees' bytes per triangle (exact answers)",
+        x_label: "bytes per triangle (both trees)",
+        y_label: "time for the poses (ms)",
+        log_x: false,
+        log_y: true,
+        series: all,
+    }
+}

@@ -107,6 +107,7 @@ pub fn write_trades(trades: &[Trade], dir: &Path) -> Result<PathBuf, Failure> {
         "error_mean",
         "error_max",
         "bv_tests_mean",
+        "bytes_per_triangle",
         "pareto",
     ];
     let rows = trades.iter().map(|t| {
@@ -118,6 +119,7 @@ pub fn write_trades(trades: &[Trade], dir: &Path) -> Result<PathBuf, Failure> {
             t.error_mean.to_string(),
             t.error_max.to_string(),
             t.bv_tests.to_string(),
+            t.bytes_per_triangle.to_string(),
             t.pareto.to_string(),
         ])
     });

@@ -189,6 +189,9 @@ fn run_accuracy(args: &ExperimentArgs, size: Size, started: Instant) -> Result<(
         plot::write(&spec.chart(&trades, &scenes), &path)?;
         written.push(path);
     }
+    let path = args.out.join("accuracy-size.svg");
+    plot::write(&charts::size_chart(&trades, &scenes), &path)?;
+    written.push(path);
     table::print_trades(&trades, &scenes)?;
     print_written(&format!("ran in {}", human_seconds(seconds)), &written)
 }

@@ -58,7 +58,8 @@ const TRADE_TABLES: [TradeTable; 2] = [
 ];
 
 /// Prints one table per scene and query: every choice, fastest first, with its time, its
-/// errors and its volume tests, and a `*` on the choices of the Pareto front.
+/// errors, its volume tests and its trees' bytes per triangle, and a `*` on the choices of
+/// the Pareto front.
 pub fn print_trades(trades: &[Trade], scenes: &[Workload]) -> Result<(), Failure> {
     for scene in scenes {
         for table in &TRADE_TABLES {
@@ -75,21 +76,23 @@ pub fn print_trades(trades: &[Trade], scenes: &[Workload]) -> Result<(), Failure
                 table.error
             )?;
             out!(
-                "  {:<40} {:>10} {:>12} {:>12} {:>10}",
+                "  {:<40} {:>10} {:>12} {:>12} {:>10} {:>9}",
                 "choice",
                 "time",
                 "error mean",
                 "error max",
-                "bv tests"
+                "bv tests",
+                "bytes/tri"
             )?;
             for t in rows {
                 out!(
-                    "  {:<40} {:>10} {:>12.2e} {:>12.2e} {:>10.0} {}",
+                    "  {:<40} {:>10} {:>12.2e} {:>12.2e} {:>10.0} {:>9.1} {}",
                     t.choice,
                     human_seconds(t.seconds),
                     t.error_mean,
                     t.error_max,
                     t.bv_tests,
+                    t.bytes_per_triangle,
                     if t.pareto { "*" } else { "" }
                 )?;
             }
