@@ -204,6 +204,14 @@ pub enum BuildError {
     /// `scale` is not a finite number greater than 0.
     #[error("scale {0} is not a finite number greater than 0 (--scale)")]
     Scale(f64),
+    /// A stored coordinate beyond what the compact layout's boxes can span.
+    #[error("vertex {vertex}: coordinate {value:e} is beyond the compact layout's range (±{:e}; its half-widths stop at 3.4e38): use --layout fast, or --scale", crate::bv::COMPACT_COORDINATE_LIMIT)]
+    CompactRange {
+        /// The vertex (0-based input order).
+        vertex: usize,
+        /// Its stored coordinate.
+        value: f64,
+    },
     /// The compact layout asked for a tree other than f32 oriented boxes.
     #[error(transparent)]
     Layout(#[from] LayoutError),
@@ -383,6 +391,19 @@ fn build_as<B: BoundingVolume>(
                 placement,
             }
         });
+    }
+    // Compact boxes store half-widths as bfloat16, finite up to 3.4e38: a model within
+    // ±COMPACT_COORDINATE_LIMIT has boxes at most √3 times that wide.
+    if B::NODE_LAYOUT == Layout::Compact {
+        let limit = crate::bv::COMPACT_COORDINATE_LIMIT;
+        let beyond = positions.iter().enumerate().find_map(|(vertex, p)| {
+            p.iter()
+                .find(|c| c.abs() > limit)
+                .map(|&value| (vertex, value))
+        });
+        if let Some((vertex, value)) = beyond {
+            return Err(BuildError::CompactRange { vertex, value });
+        }
     }
     // The statistics that do not depend on the tree are found alongside it.
     let (draft, stats) = rayon::join(

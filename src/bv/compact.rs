@@ -38,6 +38,10 @@ pub struct CompactObb {
     pad: u16,
 }
 
+/// The largest stored coordinate (absolute) a compact tree may hold: its boxes are then at
+/// most √3 times that wide, within bfloat16's largest finite value (3.39e38).
+pub const COMPACT_COORDINATE_LIMIT: f64 = 1e38;
+
 /// What a quaternion component is multiplied by before it is rounded to an `i16`.
 pub const QUATERNION_SCALE: f64 = 32767.0;
 
@@ -82,7 +86,8 @@ fn quantise_frame(frame: &Matrix3<f64>) -> [i16; 4] {
         m.set_column(2, &(-m.column(2)));
     }
     let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
-    // Saturating casts of values in [-32767, 32767] (NaN, from a degenerate frame, is 0).
+    // Saturating casts of values in [-32767, 32767]. NaN, from a degenerate frame, is 0:
+    // the zero quaternion decodes to the identity frame, along which the box is measured.
     [q.w, q.i, q.j, q.k].map(|c| (c * QUATERNION_SCALE).round() as i16)
 }
 
@@ -92,8 +97,8 @@ fn quantise_frame(frame: &Matrix3<f64>) -> [i16; 4] {
 /// [`QUATERNION_SCALE`]² and `2 / |q|²` is taken to first order about it (a relative error
 /// of about 1e-8, far inside the frames' tolerance): multiplications only, where a division
 /// would add its latency to every box test. A quaternion far from that length (a damaged,
-/// unverified file) gives a frame far from orthonormal, or non-finite entries, which
-/// `validate` rejects and the pair tests read as "may overlap" when not finite.
+/// unverified file) gives a frame far from orthonormal, which `validate` rejects (the zero
+/// quaternion gives the identity: i16 components keep every entry finite).
 #[inline]
 pub fn decode_frame(q: [i16; 4]) -> Matrix3<f64> {
     const INV_N0: f64 = 1.0 / (QUATERNION_SCALE * QUATERNION_SCALE);

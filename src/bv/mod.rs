@@ -14,7 +14,7 @@ mod pair_f32;
 mod sphere;
 
 pub use aabb::Aabb;
-pub use compact::CompactObb;
+pub use compact::{CompactObb, COMPACT_COORDINATE_LIMIT};
 pub use obb::Obb;
 pub use sphere::Sphere;
 
@@ -81,8 +81,8 @@ pub enum Layout {
     #[default]
     Fast,
     /// Quantised boxes ([`CompactObb`], 32-byte nodes instead of 64), built with four faces
-    /// per leaf by default ([`Layout::default_leaf_size`]): under a third of the bytes of a
-    /// default fast tree, for slower queries. f32 oriented boxes only.
+    /// per leaf by default ([`Layout::default_leaf_size`]): about a third of the bytes of a
+    /// default fast tree on typical meshes, for slower queries. f32 oriented boxes only.
     Compact,
 }
 

@@ -100,13 +100,13 @@ pub struct TreeArgs {
     /// spheres the dissertation's comparisons used) [default: box-centre].
     #[arg(long, value_enum)]
     pub sphere_fit: Option<SphereFitArg>,
-    /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the compact encoding
+    /// Most triangles per leaf, 1 to 128. 1 gives a binary tree with the binary encoding
     /// [default: 1; 4 with --layout compact].
     #[arg(long, value_name = "N")]
     pub leaf_size: Option<u32>,
     /// How nodes are stored: `fast` (plain boxes, the fastest queries) or `compact`
     /// (quantised boxes, with four triangles per leaf unless --leaf-size says otherwise:
-    /// under a third of the default file size, slower queries; f32 OBB trees only)
+    /// about a third of the default file size on typical meshes, slower queries; f32 OBB trees only)
     /// [default: fast].
     #[arg(long, value_enum)]
     pub layout: Option<LayoutArg>,

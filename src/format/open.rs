@@ -415,12 +415,12 @@ impl ObbtFile {
         super::write::write_atomic(path.as_ref(), self.bytes())
     }
 
-    /// The tree typed as volume `B`; an error if the file stores another type or precision.
+    /// The tree typed as volume `B`; an error if the file stores another node type.
     ///
     /// # Errors
     ///
-    /// - [`FormatError::WrongType`] if the file stores another volume type or precision
-    ///   ([`ObbtFile::visit`] takes whichever it stores).
+    /// - [`FormatError::WrongType`] if the file stores another volume type, precision or
+    ///   layout ([`ObbtFile::visit`] takes whichever it stores).
     /// - [`FormatError::Section`] if a required section cannot be viewed as records.
     ///
     /// # Examples
@@ -601,7 +601,11 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
         .ok_or_else(|| unknown(at.fit_method, header.fit_method))?;
     let layout =
         Layout::from_tag(header.layout).ok_or_else(|| unknown(at.layout, header.layout))?;
-    let node = NodeType::new(bv, precision, layout).map_err(|e| field(at.layout, e.to_string()))?;
+    let node = NodeType::new(bv, precision, layout).map_err(|e| {
+        let (bv, precision) = (e.bv.name(), e.precision.name());
+        let m = format!("the compact layout exists for obb f32 trees only, not {bv} {precision}");
+        field(at.layout, m)
+    })?;
     let leaf_size = u32::from(header.leaf_size.get());
     if !(1..=VARIABLE_MAX_LEAF_FACES).contains(&leaf_size) {
         return Err(field(

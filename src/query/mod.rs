@@ -70,10 +70,10 @@ impl std::fmt::Display for Side {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum QueryError {
-    /// The two trees store different volume types or precisions.
-    #[error("the trees differ in kind: A stores {a}, B stores {b}; build both with the same --bv and --precision")]
+    /// The two trees store different volume types, precisions or layouts.
+    #[error("the trees differ in kind: A stores {a}, B stores {b}; build both with the same --bv, --precision and --layout")]
     MismatchedTrees {
-        /// What A stores, e.g. `obb f32`.
+        /// What A stores, e.g. `obb f32` or `obb f32 compact`.
         a: String,
         /// What B stores.
         b: String,

@@ -145,24 +145,18 @@ impl SceneBuilder {
                 return Err(problem(Item::Object(k), "groups", m));
             }
         }
-        // One volume type and precision for the whole scene.
+        // One node type (volume, precision, layout) for the whole scene.
         if let Some(first) = self.objects.first() {
-            let kind = |o: &SceneObject| (o.asset.bv_kind(), o.asset.precision());
+            let kind = |o: &SceneObject| o.asset.node_type();
             if let Some((k, other)) = self
                 .objects
                 .iter()
                 .enumerate()
                 .find(|(_, o)| kind(o) != kind(first))
             {
-                let describe = |o: &SceneObject| {
-                    format!(
-                        "{} {}",
-                        o.asset.bv_kind().name(),
-                        o.asset.precision().name()
-                    )
-                };
+                let describe = |o: &SceneObject| o.asset.node_type().to_string();
                 let m = format!(
-                    "object {:?} stores {} but {:?} stores {}; a scene's assets share one volume type and precision",
+                    "object {:?} stores {} but {:?} stores {}; a scene's assets share one volume type, precision and layout",
                     other.name,
                     describe(other),
                     first.name,

@@ -286,8 +286,8 @@ fn effect_of(
 }
 
 /// The tree of every object, each distinct file opened or built once. Meshes are built with
-/// the default options, in the volume type and precision of the scene's `.obbt` assets
-/// (OBB f32 when it has none), so that they can be queried together.
+/// the default options, in the volume type, precision and layout of the scene's `.obbt`
+/// assets (fast OBB f32 when it has none), so that they can be queried together.
 fn open_assets(
     spec: &SceneToml,
     base: &Path,
@@ -328,6 +328,8 @@ fn open_assets(
                 if !kind_set {
                     options.bv = file.bv_kind();
                     options.precision = file.precision();
+                    options.layout = file.layout();
+                    options.leaf_size = file.layout().default_leaf_size();
                     kind_set = true;
                 }
                 file

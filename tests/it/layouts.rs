@@ -143,3 +143,31 @@ fn open_refuses_an_unknown_layout_and_a_compact_f64_header() {
         );
     }
 }
+
+#[test]
+fn compact_builds_refuse_coordinates_beyond_their_range() {
+    let cow = common::cow();
+    // Coordinates up to 2e38: finite in f32 and in the fast layout's boxes, beyond what
+    // the compact layout's bfloat16 half-widths can span.
+    let scale = 4e38;
+    let fast = BuildOptions {
+        scale,
+        ..BuildOptions::default()
+    };
+    build(&cow, &fast, None)
+        .expect("a fast build")
+        .verify()
+        .expect("verifies");
+    let error = build(&cow, &BuildOptions { scale, ..compact() }, None).expect_err("refused");
+    assert!(matches!(error, BuildError::CompactRange { .. }), "{error}");
+    assert!(error.to_string().contains("--layout fast"), "{error}");
+    // Just inside the range, a compact build verifies.
+    let inside = BuildOptions {
+        scale: 1.9e38,
+        ..compact()
+    };
+    build(&cow, &inside, None)
+        .expect("a compact build")
+        .verify()
+        .expect("verifies");
+}

@@ -137,7 +137,11 @@ fn scene_dir(name: &str) -> ScratchDir {
     let dir = scratch(name);
     std::fs::write(dir.join("cube.obj"), CUBE_OBJ).unwrap();
     let obj = dir.join("cube.obj");
-    for (out, bv) in [("cube.obbt", "obb"), ("cube-aabb.obbt", "aabb")] {
+    for (out, bv, layout) in [
+        ("cube.obbt", "obb", "fast"),
+        ("cube-aabb.obbt", "aabb", "fast"),
+        ("cube-compact.obbt", "obb", "compact"),
+    ] {
         let o = obbtree(&[
             "build",
             obj.to_str().unwrap(),
@@ -145,6 +149,8 @@ fn scene_dir(name: &str) -> ScratchDir {
             dir.join(out).to_str().unwrap(),
             "--bv",
             bv,
+            "--layout",
+            layout,
             "-q",
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
@@ -205,6 +211,21 @@ fn a_good_scene_from_a_mesh_and_a_tree_runs() {
     assert_eq!(lines[0]["events"][0]["event"], "clearance_violated");
     assert_eq!(lines[1]["pairs"], lines[0]["pairs"]);
     assert_eq!(lines[2]["summary"]["reused"], 1);
+}
+
+/// A mesh beside a compact tree is built in the compact layout too, so the scene runs and
+/// answers as with fast trees.
+#[test]
+fn a_mesh_beside_a_compact_tree_is_built_to_match() {
+    let dir = scene_dir("compact");
+    let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.2,0,0]}}\n";
+    let fast = run(&dir, GOOD, Some(frames));
+    let compact_scene = GOOD.replace("asset = \"cube.obbt\"", "asset = \"cube-compact.obbt\"");
+    let compact = run(&dir, &compact_scene, Some(frames));
+    assert!(compact.status.success(), "{}", stderr(&compact));
+    let (fast, compact) = (json_lines(&fast.stdout), json_lines(&compact.stdout));
+    assert_eq!(compact[0]["events"], fast[0]["events"]);
+    assert_eq!(compact[1]["events"], fast[1]["events"]);
 }
 
 #[test]

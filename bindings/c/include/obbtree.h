@@ -54,7 +54,7 @@ typedef enum ObbtreeStatus {
    */
   OBBTREE_STATUS_POSE = 6,
   /**
-   * The two trees store different volume types or precisions.
+   * The two trees store different volume types, precisions or layouts.
    */
   OBBTREE_STATUS_MISMATCHED_TREES = 7,
   /**
@@ -161,10 +161,6 @@ typedef struct ObbtreeInfo {
    */
   const char *encoding_name;
   /**
-   * Node layout: `"fast"` or `"compact"` (quantised boxes; static string).
-   */
-  const char *layout_name;
-  /**
    * Triangle count.
    */
   uint32_t triangles;
@@ -216,6 +212,11 @@ typedef struct ObbtreeInfo {
    * File length in bytes.
    */
   uint64_t file_bytes;
+  /**
+   * Node layout: `"fast"` or `"compact"` (quantised boxes; static string). Last, so the
+   * fields before it keep their offsets from earlier versions.
+   */
+  const char *layout_name;
 } ObbtreeInfo;
 
 /**
@@ -474,7 +475,7 @@ enum ObbtreeStatus obbtree_pose_orthonormalize(const double *pose, double *out);
 
 /**
  * Makes a pair handle for trees `a` and `b` (they may be the same tree): checks that they
- * store the same volume type and precision (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
+ * store the same volume type, precision and layout (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
  * and prepares the traversal once. `*out` is the handle, to be released with
  * `obbtree_pair_free`; NULL on failure. The handle keeps both trees mapped until it is
  * freed, even if they are closed first.

@@ -69,7 +69,7 @@ pub enum ObbtreeStatus {
     Verify = 5,
     /// A pose is not a rigid motion (not finite, not orthonormal, a reflection).
     Pose = 6,
-    /// The two trees store different volume types or precisions.
+    /// The two trees store different volume types, precisions or layouts.
     MismatchedTrees = 7,
     /// A tree's nodes are inconsistent (a damaged file that was not verified).
     CorruptTree = 8,
@@ -158,8 +158,6 @@ pub struct ObbtreeInfo {
     pub fit_name: *const c_char,
     /// Node encoding: `"binary"` or `"variable"` (static string).
     pub encoding_name: *const c_char,
-    /// Node layout: `"fast"` or `"compact"` (quantised boxes; static string).
-    pub layout_name: *const c_char,
     /// Triangle count.
     pub triangles: u32,
     /// Vertex count.
@@ -186,6 +184,9 @@ pub struct ObbtreeInfo {
     pub placement_offset: [f64; 3],
     /// File length in bytes.
     pub file_bytes: u64,
+    /// Node layout: `"fast"` or `"compact"` (quantised boxes; static string). Last, so the
+    /// fields before it keep their offsets from earlier versions.
+    pub layout_name: *const c_char,
 }
 
 /// Work a query did (the dissertation's counts, §2.5.1).
@@ -797,7 +798,6 @@ pub unsafe extern "C" fn obbtree_info(
             precision_name: precision_name.as_ptr(),
             fit_name: fit_name(info.fit).as_ptr(),
             encoding_name: encoding_name(info.encoding).as_ptr(),
-            layout_name: layout_name(info.layout).as_ptr(),
             triangles: info.triangles,
             vertices: info.vertices,
             nodes: info.nodes,
@@ -811,6 +811,7 @@ pub unsafe extern "C" fn obbtree_info(
             placement_scale: info.placement.scale,
             placement_offset: info.placement.offset,
             file_bytes: info.file_bytes,
+            layout_name: layout_name(info.layout).as_ptr(),
         });
         Ok(())
     })
@@ -874,7 +875,7 @@ pub unsafe extern "C" fn obbtree_pose_orthonormalize(
 // ---------------------------------------------------------------------------------------
 
 /// Makes a pair handle for trees `a` and `b` (they may be the same tree): checks that they
-/// store the same volume type and precision (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
+/// store the same volume type, precision and layout (`OBBTREE_STATUS_MISMATCHED_TREES` otherwise)
 /// and prepares the traversal once. `*out` is the handle, to be released with
 /// `obbtree_pair_free`; NULL on failure. The handle keeps both trees mapped until it is
 /// freed, even if they are closed first.

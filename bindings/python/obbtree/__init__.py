@@ -129,8 +129,8 @@ def build(
 
     Options (those of ``obbtree build``): ``bv`` "obb", "aabb" or "sphere"; ``precision``
     "f32" or "f64" (stored vertices and volumes; queries compute in f64); ``layout``
-    "fast" or "compact" (quantised f32 boxes: under a third of the file size, slower
-    queries); ``leaf_size`` 1 to 128 triangles per leaf (default 1, or 4 for the compact
+    "fast" or "compact" (quantised f32 boxes: about a third of the file size on typical
+    meshes, slower queries); ``leaf_size`` 1 to 128 triangles per leaf (default 1, or 4 for the compact
     layout); ``scale`` multiplies every coordinate before storing
     (0.001: millimetres to metres); ``center`` moves the bounding-box centre to the
     origin (both recorded in ``info["placement"]``; queries work in stored units);

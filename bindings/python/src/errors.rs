@@ -126,6 +126,7 @@ impl From<BuildError> for Failure {
             | BuildError::Scale(_)
             | BuildError::SphereFit(_)
             | BuildError::Layout(_) => Kind::Option,
+            // (CompactRange, like the other coordinate overflows, is the mesh's.)
             _ => Kind::Mesh,
         };
         Failure::new(kind, e.to_string())

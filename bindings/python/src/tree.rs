@@ -250,11 +250,10 @@ impl Tree {
             Ok(file) => {
                 let info = file.info();
                 format!(
-                    "<obbtree.Tree {}: {} triangles, {} {}, {} nodes>",
+                    "<obbtree.Tree {}: {} triangles, {}, {} nodes>",
                     self.name(),
                     info.triangles,
-                    info.bv.name(),
-                    info.precision.name(),
+                    file.node_type(),
                     info.nodes
                 )
             }
