@@ -214,6 +214,10 @@ impl BoundingVolume for CompactObb {
             .max_distance_upper_bound(&other.decode(), b_to_a)
     }
 
+    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
+        self.decode().point_distance_lower_bound(p)
+    }
+
     fn world_aabb(&self, pose: &Pose) -> super::Aabb<f64> {
         self.decode().world_aabb(pose)
     }

@@ -385,6 +385,11 @@ pub trait BoundingVolume:
     /// `other` (posed as in [`BoundingVolume::overlaps`]).
     fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64;
 
+    /// A lower bound on the distance from model-frame point `p` to the volume (model units;
+    /// 0 inside): what a closest-point query prunes with. Conservative for the stored
+    /// frame's error and for rounding; 0 for a damaged volume.
+    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64;
+
     /// An axis-aligned box containing this volume once mapped by `pose` (a model's pose: the
     /// box is in world coordinates): the broad phase of scenes bounds each posed model by
     /// the world box of its root volume, with no traversal. Conservative: widened for the

@@ -130,6 +130,19 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         dot(d, d).sqrt() <= self.radius.to_f64() + tolerance
     }
 
+    /// The distance to the centre less the radius, less a few ulps of both.
+    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
+        let c = point_to_f64(&self.center);
+        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let (length, radius) = (dot(d, d).sqrt(), self.radius.to_f64());
+        let bound = length - radius - 8.0 * f64::EPSILON * (length + radius + crate::bv::l1(&c));
+        if bound.is_nan() {
+            0.0
+        } else {
+            bound.max(0.0)
+        }
+    }
+
     #[inline]
     fn overlaps(&self, other: &Self, b_to_a: &Pose, _guard: f64) -> bool {
         // A few ulps of slack: the mapped centre is rounded, and a sphere test must never

@@ -26,6 +26,7 @@
 //! ```
 
 mod batch;
+mod closest;
 mod collide;
 mod descent;
 pub mod details;
@@ -38,6 +39,7 @@ mod work;
 
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
 pub use batch::{batch, BatchError, BatchOptions, PoseBatch};
+pub use closest::{closest_points, ClosestOptions, ClosestPoint, ClosestResult};
 pub use collide::{BoxTest, CollideOptions, CollideResult};
 pub use descent::DescentRule;
 pub use distance::{

@@ -10,6 +10,7 @@ mod build_roundtrip;
 mod bv_pair;
 mod cad_work;
 mod cli;
+mod closest;
 mod concurrency;
 mod contact_work;
 mod corruption;

@@ -15,13 +15,17 @@
 //! - [`triangle_distance`]: minimum distance and a closest pair, `0` exactly when
 //!   [`triangles_intersect`] says they touch.
 //! - [`triangle_max_distance`]: maximum distance, attained at a corner pair.
+//! - [`closest_point_on_triangle`]: the closest point of one triangle to a point, with the
+//!   [`Feature`] (face, edge, corner) it lies on.
 
 mod distance;
 mod overlap;
+mod point;
 mod predicates;
 
 pub use distance::{triangle_distance, triangle_max_distance};
 pub use overlap::triangles_intersect;
+pub use point::{closest_point_on_triangle, Feature};
 
 use nalgebra::Vector3;
 

@@ -1,0 +1,242 @@
+//! The closest point of one posed model to query points: a best-first descent of one tree,
+//! pruned by each volume's lower bound on its distance to the point.
+
+use super::triangle::{closest_point_on_triangle, Feature};
+use super::{source_id, QueryError, Side, Work};
+use crate::bv::BoundingVolume;
+use crate::format::{ObbtFile, TreeVisitor};
+use crate::pose::Pose;
+use crate::tree::{NodeKind, TreeView};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// How a closest-point query is asked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosestOptions {
+    /// Only points of the model nearer than this count (world units, `> 0`, may be
+    /// infinite): a point farther from the whole model gets no answer, sooner.
+    pub max_distance: f64,
+}
+
+impl Default for ClosestOptions {
+    fn default() -> Self {
+        ClosestOptions {
+            max_distance: f64::INFINITY,
+        }
+    }
+}
+
+/// The closest point of a model to a query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosestPoint {
+    /// Distance from the query point (world units).
+    pub distance: f64,
+    /// The closest point of the model's surface, world frame.
+    pub point: [f64; 3],
+    /// Its triangle, as an input-mesh triangle id.
+    pub triangle: u32,
+    /// Where on that triangle it lies (corners and edges in the input's vertex order).
+    pub feature: Feature,
+}
+
+/// The answer for one query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosestResult {
+    /// The closest point; `None` when the model is at least
+    /// [`ClosestOptions::max_distance`] away.
+    pub closest: Option<ClosestPoint>,
+    /// Work done: D and I count volumes pruned and kept, S and K triangles tested (K those
+    /// the point lies on).
+    pub work: Work,
+}
+
+impl ClosestResult {
+    /// The distance, infinite without an answer.
+    pub fn distance(&self) -> f64 {
+        self.closest.map_or(f64::INFINITY, |c| c.distance)
+    }
+}
+
+/// The closest point of `model`, posed by `pose` (model frame to world), to each of
+/// `points` (world frame), computed in parallel.
+///
+/// # Errors
+///
+/// - [`QueryError::BadOption`] for a non-finite query point or a `max_distance` that is not
+///   greater than 0.
+/// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::format::ObbtFile;
+/// use obbtree::query::{closest_points, ClosestOptions, Pose};
+///
+/// let table = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt"))?;
+/// let above = [[0.0, 0.0, 5.0], [0.1, 0.2, 3.0]];
+/// let answers = closest_points(&table, &Pose::identity(), &above, &ClosestOptions::default())?;
+/// for (p, answer) in above.iter().zip(&answers) {
+///     let c = answer.closest.expect("no max_distance: always an answer");
+///     println!("{p:?}: triangle {} at {:.3} ({})", c.triangle, c.distance, c.feature.name());
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn closest_points(
+    model: &ObbtFile,
+    pose: &Pose,
+    points: &[[f64; 3]],
+    options: &ClosestOptions,
+) -> Result<Vec<ClosestResult>, QueryError> {
+    // (NaN fails too.)
+    if options.max_distance.partial_cmp(&0.0) != Some(Ordering::Greater) {
+        return Err(QueryError::BadOption {
+            name: "max_distance",
+            requirement: "greater than 0",
+            value: options.max_distance,
+        });
+    }
+    if let Some(bad) = points.iter().flatten().find(|x| !x.is_finite()) {
+        return Err(QueryError::BadOption {
+            name: "query point coordinate",
+            requirement: "finite",
+            value: *bad,
+        });
+    }
+    /// The typed descent, run for every point.
+    struct Visit<'q> {
+        pose: &'q Pose,
+        points: &'q [[f64; 3]],
+        options: &'q ClosestOptions,
+    }
+    impl TreeVisitor for Visit<'_> {
+        type Output = Result<Vec<ClosestResult>, QueryError>;
+        fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
+            // World to model: the world frame posed in the model's.
+            let to_model = Pose::relative(self.pose, &Pose::identity());
+            self.points
+                .par_iter()
+                .map(|p| {
+                    let local = to_model.apply(&Vector3::from(*p));
+                    let found = descend(&tree, &local, self.options.max_distance)?;
+                    Ok(ClosestResult {
+                        closest: found.best.map(|(face, point, feature)| ClosestPoint {
+                            distance: found.distance,
+                            point: self.pose.apply(&point).into(),
+                            triangle: face,
+                            feature,
+                        }),
+                        work: found.work,
+                    })
+                })
+                .collect()
+        }
+    }
+    model.visit(Visit {
+        pose,
+        points,
+        options,
+    })?
+}
+
+/// A node waiting, by its lower bound (smallest first in a max-heap).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Waiting {
+    bound: f64,
+    node: u32,
+}
+
+impl Eq for Waiting {}
+
+impl PartialOrd for Waiting {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Waiting {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.bound.total_cmp(&self.bound)
+    }
+}
+
+/// What one descent found: the best triangle (input id), its point (model frame) and
+/// feature, its distance, and the work.
+struct Found {
+    best: Option<(u32, Vector3<f64>, Feature)>,
+    distance: f64,
+    work: Work,
+}
+
+/// Best first: the node of smallest lower bound is expanded next, and the descent stops
+/// when that bound reaches the best distance found (every node waiting is at least as far).
+fn descend<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    p: &Vector3<f64>,
+    max_distance: f64,
+) -> Result<Found, QueryError> {
+    let corrupt = |what| QueryError::CorruptTree {
+        which: Side::A,
+        what,
+    };
+    let mut found = Found {
+        best: None,
+        distance: max_distance,
+        work: Work::default(),
+    };
+    let point = [p.x, p.y, p.z];
+    let root = tree.node(0).ok_or(corrupt("node index out of bounds"))?;
+    let mut heap = BinaryHeap::new();
+    heap.push(Waiting {
+        bound: root.bv.point_distance_lower_bound(point),
+        node: 0,
+    });
+    while let Some(Waiting { bound, node }) = heap.pop() {
+        found.work.nodes_visited += 1;
+        if bound >= found.distance {
+            // It and every node still waiting are pruned.
+            found.work.bv_disjoint += 1 + heap.len() as u64;
+            break;
+        }
+        found.work.bv_overlap += 1;
+        match tree.node_kind(node).map_err(|d| corrupt(d.describe()))? {
+            NodeKind::Faces(faces) => {
+                for face in faces {
+                    let t = tree
+                        .triangle(face)
+                        .ok_or(corrupt("face or vertex index out of bounds"))?
+                        .map(Vector3::from);
+                    let (q, feature) = closest_point_on_triangle(p, &t);
+                    let d = (p - q).norm();
+                    if d == 0.0 {
+                        found.work.tri_contact += 1;
+                    } else {
+                        found.work.tri_separated += 1;
+                    }
+                    if d < found.distance {
+                        found.distance = d;
+                        found.best = Some((source_id(tree, face, Side::A)?, q, feature));
+                    }
+                }
+            }
+            // Children come after their parent (checked by `node_kind`): the descent
+            // ends on any file.
+            NodeKind::Children(children) => {
+                for child in children {
+                    let n = tree
+                        .node(child)
+                        .ok_or(corrupt("node index out of bounds"))?;
+                    let bound = n.bv.point_distance_lower_bound(point);
+                    if bound < found.distance {
+                        heap.push(Waiting { bound, node: child });
+                    } else {
+                        found.work.nodes_visited += 1;
+                        found.work.bv_disjoint += 1;
+                    }
+                }
+            }
+        }
+    }
+    Ok(found)
+}

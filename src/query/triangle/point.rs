@@ -1,0 +1,109 @@
+//! The closest point of a triangle to a point, and the feature it lies on.
+
+use super::Triangle;
+use nalgebra::Vector3;
+
+/// Where on a triangle its closest point to a query point lies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Feature {
+    /// Inside the triangle.
+    Face,
+    /// On edge `k`, from corner `k` to corner `(k + 1) % 3`, between its ends.
+    Edge(u8),
+    /// At corner `k`.
+    Vertex(u8),
+}
+
+impl Feature {
+    /// `"face"`, `"edge"` or `"vertex"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Feature::Face => "face",
+            Feature::Edge(_) => "edge",
+            Feature::Vertex(_) => "vertex",
+        }
+    }
+
+    /// The edge's or corner's number (0 to 2); 0 for a face.
+    pub fn index(self) -> u8 {
+        match self {
+            Feature::Face => 0,
+            Feature::Edge(k) | Feature::Vertex(k) => k,
+        }
+    }
+}
+
+/// The point of triangle `t` closest to `p`, and the feature it lies on: by the Voronoi
+/// regions of the corners, then of the edges, then the face (Ericson, *Real-Time Collision
+/// Detection* §5.1.5). A zero-area triangle is the segment or point it spans: its closest
+/// point is the nearest of its edges'. Never NaN for finite input.
+pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (*a, Feature::Vertex(0));
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (*b, Feature::Vertex(1));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0 {
+        return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (*c, Feature::Vertex(2));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0 {
+        return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
+    }
+    let va = d3 * d6 - d5 * d4;
+    let (e4, e5) = (d4 - d3, d5 - d6);
+    if va <= 0.0 && e4 >= 0.0 && e5 >= 0.0 && e4 + e5 > 0.0 {
+        return (b + (c - b) * (e4 / (e4 + e5)), Feature::Edge(1));
+    }
+    let sum = va + vb + vc;
+    if sum > 0.0 && sum.is_finite() {
+        let (v, w) = (vb / sum, vc / sum);
+        return (a + ab * v + ac * w, Feature::Face);
+    }
+    // A zero-area triangle (or one so thin that rounding left no region): its edges.
+    let mut best = (*a, Feature::Vertex(0), f64::INFINITY);
+    for (k, (s, e)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
+        // `k` is 0, 1 or 2.
+        let (q, feature) = closest_on_segment(p, s, e, k as u8);
+        let d = (p - q).norm_squared();
+        if d < best.2 {
+            best = (q, feature, d);
+        }
+    }
+    (best.0, best.1)
+}
+
+/// The point of segment `s → e` (edge `k` of its triangle) closest to `p`.
+fn closest_on_segment(
+    p: &Vector3<f64>,
+    s: &Vector3<f64>,
+    e: &Vector3<f64>,
+    k: u8,
+) -> (Vector3<f64>, Feature) {
+    let d = e - s;
+    let length2 = d.norm_squared();
+    let along = if length2 > 0.0 {
+        (p - s).dot(&d) / length2
+    } else {
+        0.0
+    };
+    if along <= 0.0 || along.is_nan() {
+        (*s, Feature::Vertex(k))
+    } else if along >= 1.0 {
+        (*e, Feature::Vertex((k + 1) % 3))
+    } else {
+        (s + d * along, Feature::Edge(k))
+    }
+}

@@ -1,0 +1,198 @@
+//! Closest points of one posed model (`query::closest_points`), against brute force over
+//! every triangle with an independent point–triangle distance, for every tree type.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
+
+use crate::common;
+
+use nalgebra::Vector3;
+use obbtree::build::build;
+use obbtree::format::ObbtFile;
+use obbtree::generate::Rng;
+use obbtree::query::triangle::Feature;
+use obbtree::query::{closest_points, ClosestOptions, Pose, QueryError};
+
+/// Distance from `p` to triangle `t`, computed another way than the library's: the
+/// projection on the plane when it falls inside (edge signs), else the nearest of the
+/// three segments.
+fn point_triangle_distance(p: &Vector3<f64>, t: &[[f64; 3]; 3]) -> f64 {
+    let [a, b, c] = t.map(Vector3::from);
+    let segment = |s: Vector3<f64>, e: Vector3<f64>| {
+        let d = e - s;
+        let l2 = d.norm_squared();
+        let u = if l2 > 0.0 {
+            ((p - s).dot(&d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (s + d * u)).norm()
+    };
+    let edges = segment(a, b).min(segment(b, c)).min(segment(c, a));
+    let n = (b - a).cross(&(c - a));
+    let n2 = n.norm_squared();
+    if n2 == 0.0 {
+        return edges;
+    }
+    let q = p - n * (n.dot(&(p - a)) / n2);
+    let inside = [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|(s, e)| (e - s).cross(&(q - s)).dot(&n) >= 0.0);
+    if inside {
+        (p - q).norm().min(edges)
+    } else {
+        edges
+    }
+}
+
+/// Query points for `file`'s stored triangles posed by `pose`: near the surface (jittered
+/// corners and centroids), exactly on corners and edge midpoints, and far away.
+fn query_points(triangles: &[(u32, [[f64; 3]; 3])], pose: &Pose, rng: &mut Rng) -> Vec<[f64; 3]> {
+    let mut out = Vec::new();
+    for k in 0..60 {
+        let (_, t) = triangles[rng.below(triangles.len())];
+        let [a, b, c] = t.map(Vector3::from);
+        let mut jitter = |r: f64| Vector3::new(rng.signed(), rng.signed(), rng.signed()) * r;
+        let local = match k % 5 {
+            0 => a,
+            1 => (a + b) / 2.0,
+            2 => (a + b + c) / 3.0 + jitter(0.05),
+            3 => a + jitter(0.2),
+            _ => jitter(3.0),
+        };
+        out.push(pose.apply(&local).into());
+    }
+    out
+}
+
+#[test]
+fn closest_points_match_brute_force_for_every_tree_type() {
+    let cow = common::cow();
+    let mut rng = Rng::new(11);
+    for options in common::all_options() {
+        let file = build(&cow, &options, None).expect("builds");
+        let triangles = common::file_triangles(&file);
+        for seed in 0..3 {
+            let pose = common::turned_pose(seed, 0.7);
+            let points = query_points(&triangles, &pose, &mut rng);
+            let answers =
+                closest_points(&file, &pose, &points, &ClosestOptions::default()).expect("answers");
+            let to_model = Pose::relative(&pose, &Pose::identity());
+            for (p, answer) in points.iter().zip(&answers) {
+                let local = to_model.apply(&Vector3::from(*p));
+                let brute = triangles
+                    .iter()
+                    .map(|(_, t)| point_triangle_distance(&local, t))
+                    .fold(f64::INFINITY, f64::min);
+                let c = answer.closest.expect("no max_distance: an answer");
+                let what = format!("{options:?} seed {seed} point {p:?}");
+                assert!(
+                    (c.distance - brute).abs() <= 1e-12 * (1.0 + brute),
+                    "{what}: {} vs {brute}",
+                    c.distance
+                );
+                // The point is on the named triangle, at the distance reported.
+                let named = triangles
+                    .iter()
+                    .find(|(id, _)| *id == c.triangle)
+                    .expect("a triangle id");
+                let on = to_model.apply(&Vector3::from(c.point));
+                assert!(point_triangle_distance(&on, &named.1) <= 1e-12, "{what}");
+                let reach = (Vector3::from(*p) - Vector3::from(c.point)).norm();
+                assert!(
+                    (reach - c.distance).abs() <= 1e-12 * (1.0 + brute),
+                    "{what}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn max_distance_cuts_answers_exactly_where_brute_force_says() {
+    let cow = common::cow();
+    let file = build(&cow, &Default::default(), None).expect("builds");
+    let triangles = common::file_triangles(&file);
+    let pose = common::turned_pose(5, 0.0);
+    let points = query_points(&triangles, &pose, &mut Rng::new(3));
+    let exact = closest_points(&file, &pose, &points, &ClosestOptions::default()).expect("answers");
+    let limit = 0.05;
+    let cut = closest_points(
+        &file,
+        &pose,
+        &points,
+        &ClosestOptions {
+            max_distance: limit,
+        },
+    )
+    .expect("answers");
+    let (mut kept, mut dropped) = (0, 0);
+    for (e, c) in exact.iter().zip(&cut) {
+        if e.distance() < limit {
+            assert_eq!(c.closest.map(|x| x.distance), e.closest.map(|x| x.distance));
+            kept += 1;
+        } else {
+            assert!(c.closest.is_none());
+            // Pruning with the limit does less work.
+            assert!(c.work.bv_tests() <= e.work.bv_tests());
+            dropped += 1;
+        }
+    }
+    assert!(kept > 10 && dropped > 10, "{kept} kept, {dropped} dropped");
+}
+
+#[test]
+fn features_name_where_the_point_lies() {
+    let mesh = common::cube(0.5);
+    let file: ObbtFile = build(&mesh, &Default::default(), None).expect("builds");
+    let at = |p: [f64; 3]| {
+        closest_points(&file, &Pose::identity(), &[p], &ClosestOptions::default()).expect("answers")
+            [0]
+        .closest
+        .expect("an answer")
+    };
+    // Above the middle of the top face (its diagonal edge aside).
+    let face = at([0.2, 0.1, 2.0]);
+    assert!(
+        (face.distance - 1.5).abs() < 1e-15 && face.feature == Feature::Face,
+        "{face:?}"
+    );
+    // Beyond a corner along its diagonal: the corner, at every triangle meeting there.
+    let corner = at([1.5, 1.5, 1.5]);
+    assert!(matches!(corner.feature, Feature::Vertex(_)), "{corner:?}");
+    assert!((corner.distance - 3f64.sqrt()).abs() < 1e-15);
+    // Beside the middle of an edge of the cube.
+    let edge = at([1.0, 0.0, 1.0]);
+    assert!(matches!(edge.feature, Feature::Edge(_)), "{edge:?}");
+    assert!((edge.distance - 0.5f64.sqrt()).abs() < 1e-15);
+    // On the surface: distance 0, the point itself.
+    let on = at([0.5, 0.25, -0.125]);
+    assert_eq!(on.distance, 0.0);
+    assert_eq!(on.point, [0.5, 0.25, -0.125]);
+}
+
+#[test]
+fn bad_query_points_and_limits_are_refused() {
+    let file = build(&common::cube(0.5), &Default::default(), None).expect("builds");
+    let pose = Pose::identity();
+    for (points, max_distance, name) in [
+        (
+            vec![[0.0, f64::NAN, 0.0]],
+            f64::INFINITY,
+            "query point coordinate",
+        ),
+        (
+            vec![[f64::INFINITY, 0.0, 0.0]],
+            f64::INFINITY,
+            "query point coordinate",
+        ),
+        (vec![[0.0; 3]], 0.0, "max_distance"),
+        (vec![[0.0; 3]], f64::NAN, "max_distance"),
+    ] {
+        let error = closest_points(&file, &pose, &points, &ClosestOptions { max_distance })
+            .expect_err("refused");
+        assert!(
+            matches!(error, QueryError::BadOption { name: n, .. } if n == name),
+            "{error}"
+        );
+    }
+}
