@@ -2,6 +2,7 @@
 //! errors become one line on stderr and exit status 1 (usage errors: 2, from clap).
 
 mod build;
+mod closest;
 mod demo;
 mod experiment;
 mod files;
@@ -46,6 +47,7 @@ enum Command {
     Collide(query::CollideArgs),
     Distance(query::DistanceArgs),
     Span(query::SpanArgs),
+    Closest(closest::ClosestArgs),
     Scene(scene::SceneArgs),
     Demo(demo::DemoArgs),
     Experiment(experiment::ExperimentArgs),
@@ -139,6 +141,7 @@ pub fn main() -> ExitCode {
         Command::Collide(args) => query::collide(&args),
         Command::Distance(args) => query::distance(&args),
         Command::Span(args) => query::span(&args),
+        Command::Closest(args) => closest::run(&args),
         Command::Scene(args) => scene::run(&args).map(|_| ()),
         Command::Demo(args) => demo::run(&args),
         Command::Experiment(args) => experiment::run(&args),

@@ -35,6 +35,41 @@ pub struct PoseArgs {
     pub orthonormalize: bool,
 }
 
+/// Where one model is (the one-model queries): a pose from a flag.
+#[derive(Args, Debug, Clone)]
+pub struct ModelPoseArgs {
+    /// Pose of the model (default: identity): numbers in the --pose-format, separated by
+    /// commas or spaces. World point = R p + T.
+    #[arg(long, value_name = "P", allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// How the numbers of the pose are laid out, as for the pair queries: rt (12), tq-wxyz
+    /// (7), tq-xyzw (7, ROS order), matrix4 (16).
+    #[arg(long, value_enum, default_value_t = PoseFormatArg::Rt, value_name = "FORMAT")]
+    pub pose_format: PoseFormatArg,
+    /// Replace the rotation by the nearest rotation (corrections above 1e-6 reported, above
+    /// 1e-2 refused).
+    #[arg(long)]
+    pub orthonormalize: bool,
+}
+
+impl ModelPoseArgs {
+    /// The pose of --pose (identity without it).
+    pub fn pose(&self) -> Result<Pose, Failure> {
+        let Some(text) = self.pose.as_deref() else {
+            return Ok(Pose::identity());
+        };
+        let parsed = self
+            .pose_format
+            .format()
+            .parse(&parse_numbers(text, "--pose")?, self.orthonormalize)
+            .with_context(|| "--pose")?;
+        let mut repairs = Repairs::default();
+        let pose = repairs.note(&parsed, || "--pose".to_string());
+        repairs.report("--pose");
+        Ok(pose)
+    }
+}
+
 /// `--pose-format` values, named as [`PoseFormat::name`].
 #[derive(ValueEnum, Clone, Copy, Debug)]
 pub enum PoseFormatArg {

@@ -196,3 +196,61 @@ fn bad_query_points_and_limits_are_refused() {
         );
     }
 }
+
+/// `obbtree closest` prints what the library answers, point by point, and refuses bad
+/// input with one line and status 1.
+#[test]
+fn the_cli_answers_as_the_library() {
+    use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
+    let dir = scratch("closest");
+    let points = dir.join("points.txt");
+    std::fs::write(&points, "# x y z\n0 0 1\n\n0.5,0,0\n0.1 0.2 0.05\n3 3 3\n").expect("writes");
+    let pose = "1,0,0,0,0,-1,0,1,0,0.1,0,0";
+    let o = obbtree(&[
+        "closest",
+        cow().as_str(),
+        "--points",
+        points.to_str().expect("a path"),
+        "--pose",
+        pose,
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("JSON"))
+        .collect();
+    let file = build(&common::cow(), &Default::default(), None).expect("builds");
+    let queries = [
+        [0.0, 0.0, 1.0],
+        [0.5, 0.0, 0.0],
+        [0.1, 0.2, 0.05],
+        [3.0, 3.0, 3.0],
+    ];
+    let pose = Pose::from_row_major(&[1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.1, 0.0, 0.0])
+        .expect("a pose");
+    let answers =
+        closest_points(&file, &pose, &queries, &ClosestOptions::default()).expect("answers");
+    assert_eq!(lines.len(), answers.len());
+    for (i, (line, answer)) in lines.iter().zip(&answers).enumerate() {
+        let c = answer.closest.expect("an answer");
+        assert_eq!(line["point"], i);
+        assert_eq!(line["distance"].as_f64(), Some(c.distance));
+        assert_eq!(line["triangle"], c.triangle);
+        assert_eq!(line["feature"]["kind"], c.feature.name());
+    }
+    let cow_path = cow();
+    for (args, needle) in [
+        (vec!["--point", "1,2"], "--point"),
+        (vec!["--point", "0,0,nan"], "finite"),
+        (
+            vec!["--point", "0,0,0", "--max-distance", "-1"],
+            "max_distance",
+        ),
+        (vec![], "--points"),
+    ] {
+        let mut all = vec!["closest", cow_path.as_str()];
+        all.extend(args);
+        assert_bad_input(&obbtree(&all), needle);
+    }
+}

@@ -19,14 +19,16 @@ answers all of them in one call, in parallel, with the GIL released::
 A pose is a (4, 4) rigid matrix, 12 numbers (rotation row-major, then translation) or an
 ``(R, t)`` pair; a batch is (N, 4, 4) or (N, 12). A world point is ``R @ p + t``.
 
-Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``; classes
-``Tree``, ``Scene`` and the result classes; exceptions ``Error`` and its subclasses
+Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``, and
+``closest`` (one model against many points); classes ``Tree``, ``Scene`` and the result
+classes; exceptions ``Error`` and its subclasses
 ``MeshError``, ``FormatError``, ``PoseError``, ``SceneError``, ``OptionError``,
 ``FileError``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from typing import Any, Optional, Union
 
@@ -48,6 +50,7 @@ from ._obbtree import (
     WithinResult,
     __version__,
     _build,
+    _closest,
     collide,
     distance,
     open,
@@ -62,6 +65,8 @@ __all__ = [
     "distance",
     "within",
     "span",
+    "closest",
+    "ClosestResult",
     "Tree",
     "Scene",
     "CollideResult",
@@ -168,3 +173,57 @@ def build(
             f".vertices and .faces (such as a trimesh.Trimesh), not {type(mesh).__name__}"
         )
     return _build(None, vertices, faces, **options)
+
+
+@dataclasses.dataclass(frozen=True)
+class ClosestResult:
+    """The answers of ``closest`` for N query points (read-only arrays).
+
+    ``distance`` (N,) float64: from the query point to the model's surface, +inf where
+    nothing is within ``max_distance``; ``point`` (N, 3) float64: the closest surface point,
+    world frame (NaN without an answer); ``tri`` (N,) int64: its input-mesh triangle (-1);
+    ``feature`` (N,) str: where on the triangle it lies, ``"face"``, ``"edge"`` or
+    ``"vertex"`` (``""`` without an answer); ``feature_index`` (N,) int8: the edge (from
+    corner k to corner k + 1) or corner k, in the input's corner order (-1).
+    """
+
+    distance: np.ndarray
+    point: np.ndarray
+    tri: np.ndarray
+    feature: np.ndarray
+    feature_index: np.ndarray
+
+
+_FEATURES = np.array(["face", "edge", "vertex", ""])
+
+
+def closest(
+    tree: Tree,
+    pose: Any,
+    points: Any,
+    max_distance: float = np.inf,
+    *,
+    orthonormalize: bool = False,
+) -> ClosestResult:
+    """The closest point of a posed model's surface to each query point.
+
+    ``pose`` is one pose of ``tree`` (a (4, 4) matrix, 12 numbers or an ``(R, t)`` pair);
+    ``points`` is an (N, 3) array of world points, or one point (3,). Points are answered in
+    parallel with the GIL released; those farther than ``max_distance`` (world units, > 0)
+    get no answer, sooner. Returns a ``ClosestResult``.
+
+    Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points or
+    a ``max_distance`` not above 0, ``PoseError`` for a pose that is not a rigid motion.
+    """
+    array = np.asarray(points, dtype=np.float64)
+    if array.shape == (3,):
+        array = array.reshape(1, 3)
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise OptionError(f"points must be an (N, 3) array or one point (3,), got shape {array.shape}")
+    distance, point, tri, feature, index = _closest(
+        tree, pose, np.ascontiguousarray(array), float(max_distance), orthonormalize
+    )
+    arrays = [distance, point, tri, _FEATURES[feature], index]
+    for a in arrays:
+        a.flags.writeable = False
+    return ClosestResult(*arrays)

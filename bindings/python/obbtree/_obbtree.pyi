@@ -221,6 +221,19 @@ def _build(
     force: bool,
 ) -> Tree: ...
 def _from_bytes(data: bytes) -> Tree: ...
+def _closest(
+    tree: Tree,
+    pose: Poses,
+    points: npt.NDArray[np.float64],
+    max_distance: float,
+    orthonormalize: bool,
+) -> Tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.int8],
+    npt.NDArray[np.int8],
+]: ...
 def _time_rust_loop(
     a: Tree, poses_a: Poses, b: Tree, poses_b: Poses, query: str, repeat: int
 ) -> float: ...

@@ -5,6 +5,7 @@
 //! panic crosses into Python: PyO3 turns one into `pyo3_runtime.PanicException`, and the
 //! library itself does not panic on data it did not make.
 
+mod closest;
 mod errors;
 mod json;
 mod poses;
@@ -136,6 +137,7 @@ fn _obbtree(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::distance, m)?)?;
     m.add_function(wrap_pyfunction!(queries::within, m)?)?;
     m.add_function(wrap_pyfunction!(queries::span, m)?)?;
+    m.add_function(wrap_pyfunction!(closest::_closest, m)?)?;
     m.add_function(wrap_pyfunction!(queries::_time_rust_loop, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

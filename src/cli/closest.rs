@@ -1,0 +1,215 @@
+//! `obbtree closest`: the closest point of one posed model to query points.
+
+use super::build::{build_with_progress, load_mesh, TreeArgs};
+use super::files::is_obbt;
+use super::poses::{parse_numbers, ModelPoseArgs};
+use super::print::out;
+use super::{number, Failure, WithContext};
+use clap::Args;
+use obbtree::format::ObbtFile;
+use obbtree::query::{closest_points, ClosestOptions, ClosestResult};
+use serde_json::json;
+use std::io::Read;
+use std::path::PathBuf;
+
+/// Find the closest point of a posed model's surface to each query point.
+///
+/// Prints, per point, the distance, the closest point (world frame), its triangle (input
+/// mesh id) and where on the triangle it lies (face, edge or vertex). Points far from the
+/// model get no answer with --max-distance, sooner.
+///
+/// Example: obbtree closest part.obbt --point 0.1,0.2,0.3 --json
+///
+/// Example: obbtree closest part.obbt --points cloud.xyz --csv > nearest.csv
+#[derive(Args, Debug)]
+pub struct ClosestArgs {
+    /// The model: a .obbt file, or a mesh (.obj, .stl) built in memory first.
+    pub model: PathBuf,
+    /// One query point, world frame: x,y,z.
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true,
+        conflicts_with = "points"
+    )]
+    pub point: Option<String>,
+    /// Query points, world frame: a file (`-` for stdin) of lines `x y z` (or `x,y,z`);
+    /// blank lines and lines starting with `#` are skipped. Answered in parallel, printed
+    /// in input order, each with "point": its index from 0.
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    #[command(flatten)]
+    pub pose: ModelPoseArgs,
+    /// Only surface points nearer than D count (world units, > 0).
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
+    pub max_distance: Option<f64>,
+    /// Print JSON lines, one object per point.
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print CSV: a header, then one row per point.
+    #[arg(long)]
+    pub csv: bool,
+    /// How a mesh model is built in memory (not for .obbt models).
+    #[command(
+        flatten,
+        next_help_heading = "Mesh input (built in memory; not for .obbt models)"
+    )]
+    pub tree: TreeArgs,
+}
+
+/// The query points of `--point` or `--points`.
+fn query_points(args: &ClosestArgs) -> Result<Vec<[f64; 3]>, Failure> {
+    let triple = |numbers: Vec<f64>, at: &dyn Fn() -> String| -> Result<[f64; 3], Failure> {
+        <[f64; 3]>::try_from(numbers.as_slice()).map_err(|_| {
+            Failure::msg(format!(
+                "{}: {} numbers, not the 3 of x y z",
+                at(),
+                numbers.len()
+            ))
+        })
+    };
+    match (&args.point, &args.points) {
+        (Some(text), None) => Ok(vec![triple(parse_numbers(text, "--point")?, &|| {
+            "--point".into()
+        })?]),
+        (None, Some(path)) => {
+            let shown = if path.as_os_str() == "-" {
+                "<stdin>".to_string()
+            } else {
+                path.display().to_string()
+            };
+            let mut text = String::new();
+            if path.as_os_str() == "-" {
+                std::io::stdin()
+                    .read_to_string(&mut text)
+                    .with_context(|| format!("{shown}: cannot read"))?;
+            } else {
+                text = std::fs::read_to_string(path)
+                    .with_context(|| format!("{shown}: cannot read"))?;
+            }
+            let mut points = Vec::new();
+            for (line, content) in text.lines().enumerate() {
+                let content = content.trim();
+                if content.is_empty() || content.starts_with('#') {
+                    continue;
+                }
+                let at = || format!("{shown}: line {}", line + 1);
+                points.push(triple(parse_numbers(content, &at())?, &at)?);
+            }
+            if points.is_empty() {
+                return Err(Failure::msg(format!("{shown}: no points")));
+            }
+            Ok(points)
+        }
+        _ => Err(Failure::msg(
+            "give the query points: --point X,Y,Z, or --points FILE (- for stdin)",
+        )),
+    }
+}
+
+pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
+    let pose = args.pose.pose()?;
+    let points = query_points(args)?;
+    let model = if is_obbt(&args.model)
+        || args
+            .model
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("obbt"))
+    {
+        if let Some(flag) = args.tree.given().first() {
+            return Err(Failure::msg(format!(
+                "{flag} applies to mesh models only, and {} is a .obbt file",
+                args.model.display()
+            )));
+        }
+        ObbtFile::open(&args.model)?
+    } else {
+        let mesh = load_mesh(&args.model)?;
+        let options = args.tree.options();
+        options.validate()?;
+        build_with_progress(&mesh, &options, &args.model.display().to_string(), false)?
+    };
+    let options = ClosestOptions {
+        max_distance: args.max_distance.unwrap_or(f64::INFINITY),
+    };
+    let answers = closest_points(&model, &pose, &points, &options)?;
+    if args.csv {
+        out!("point,distance,x,y,z,triangle,feature,feature_index,bv_tests,tri_tests")?;
+    }
+    for (i, (p, answer)) in points.iter().zip(&answers).enumerate() {
+        print_answer(args, i, p, answer, points.len() > 1)?;
+    }
+    Ok(())
+}
+
+fn print_answer(
+    args: &ClosestArgs,
+    index: usize,
+    p: &[f64; 3],
+    answer: &ClosestResult,
+    many: bool,
+) -> Result<(), Failure> {
+    let work = &answer.work;
+    match (&answer.closest, args.csv, args.json) {
+        (Some(c), true, _) => out!(
+            "{index},{},{},{},{},{},{},{},{},{}",
+            c.distance,
+            c.point[0],
+            c.point[1],
+            c.point[2],
+            c.triangle,
+            c.feature.name(),
+            c.feature.index(),
+            work.bv_tests(),
+            work.tri_tests()
+        )?,
+        (None, true, _) => out!("{index},inf,,,,,,,{},{}", work.bv_tests(), work.tri_tests())?,
+        (c, false, true) => {
+            let mut object = json!({
+                "point": index,
+                "query": p,
+                "found": c.is_some(),
+                "distance": c.map_or(serde_json::Value::Null, |c| json!(c.distance)),
+                "work": {"bv_tests": work.bv_tests(), "tri_tests": work.tri_tests()},
+            });
+            if let Some(c) = c {
+                object["closest"] = json!(c.point);
+                object["triangle"] = json!(c.triangle);
+                object["feature"] = json!({"kind": c.feature.name(), "index": c.feature.index()});
+            }
+            out!("{object}")?;
+        }
+        (Some(c), false, false) => {
+            let prefix = if many {
+                format!("point {index}: ")
+            } else {
+                String::new()
+            };
+            out!(
+                "{prefix}distance {} to ({}, {}, {}) on triangle {} ({} {}); bv tests {}, triangle tests {}",
+                number(c.distance),
+                number(c.point[0]),
+                number(c.point[1]),
+                number(c.point[2]),
+                c.triangle,
+                c.feature.name(),
+                c.feature.index(),
+                work.bv_tests(),
+                work.tri_tests()
+            )?;
+        }
+        (None, false, false) => {
+            let prefix = if many {
+                format!("point {index}: ")
+            } else {
+                String::new()
+            };
+            out!(
+                "{prefix}nothing within {}; bv tests {}",
+                number(args.max_distance.unwrap_or(f64::INFINITY)),
+                work.bv_tests()
+            )?;
+        }
+    }
+    Ok(())
+}
