@@ -165,18 +165,17 @@ fn print_answer(
         )?,
         (None, true, _) => out!("{index},inf,,,,,,,{},{}", work.bv_tests(), work.tri_tests())?,
         (c, false, true) => {
-            let mut object = json!({
+            let null = serde_json::Value::Null;
+            let object = json!({
                 "point": index,
                 "query": p,
                 "found": c.is_some(),
-                "distance": c.map_or(serde_json::Value::Null, |c| json!(c.distance)),
+                "distance": c.map_or(null.clone(), |c| json!(c.distance)),
+                "closest": c.map_or(null.clone(), |c| json!(c.point)),
+                "triangle": c.map_or(null.clone(), |c| json!(c.triangle)),
+                "feature": c.map_or(null, |c| json!({"kind": c.feature.name(), "index": c.feature.index()})),
                 "work": {"bv_tests": work.bv_tests(), "tri_tests": work.tri_tests()},
             });
-            if let Some(c) = c {
-                object["closest"] = json!(c.point);
-                object["triangle"] = json!(c.triangle);
-                object["feature"] = json!({"kind": c.feature.name(), "index": c.feature.index()});
-            }
             out!("{object}")?;
         }
         (Some(c), false, false) => {
