@@ -123,6 +123,26 @@ impl<R: Real> BoundingVolume for Aabb<R> {
         Ok(())
     }
 
+    #[inline]
+    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
+        let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
+        // The excess past each face pair, in the model's exact axes: a few ulps of rounding.
+        let mut sum = 0.0;
+        for ((x, lo), hi) in p.iter().zip(lo).zip(hi) {
+            let excess =
+                (lo - x).max(x - hi) - 4.0 * f64::EPSILON * (x.abs() + lo.abs() + hi.abs());
+            if excess > 0.0 {
+                sum += excess * excess;
+            }
+        }
+        let bound = sum.sqrt();
+        if bound.is_nan() {
+            0.0
+        } else {
+            bound
+        }
+    }
+
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
         arr3::zip(p, arr3::zip(lo, hi))

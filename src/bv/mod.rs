@@ -502,6 +502,35 @@ pub fn model_axes_frame(lo: [f64; 3], hi: [f64; 3]) -> Matrix3<f64> {
     Matrix3::from_columns(&[c0, c1, c0.cross(&c1)])
 }
 
+/// A lower bound on the distance from a point to a box: `d` the point less the box's
+/// centre, `axes` the box's axes (rows, orthonormal within `frame_error`), `half` its
+/// half-widths. For `x` in the box, `|a_i·(p − x)| ≥ |a_i·d| − h_i − frame_error·Σh`, and
+/// `|v| ≥ |A v| / (1 + 2 frame_error)`; the projections' rounding is a few ulps of their
+/// terms. NaN (a damaged, unverified file) gives 0: no bound.
+#[inline(always)]
+pub(crate) fn box_point_distance_bound(
+    d: [f64; 3],
+    axes: &[[f64; 3]; 3],
+    half: [f64; 3],
+    frame_error: f64,
+) -> f64 {
+    let half_sum = half[0] + half[1] + half[2];
+    let slack = frame_error * half_sum + 8.0 * f64::EPSILON * (l1(&d) + half_sum);
+    let mut sum = 0.0;
+    for (axis, h) in axes.iter().zip(half) {
+        let excess = arr3::dot(*axis, d).abs() - h - slack;
+        if excess > 0.0 {
+            sum += excess * excess;
+        }
+    }
+    let bound = sum.sqrt() * (1.0 - 4.0 * frame_error);
+    if bound.is_nan() {
+        0.0
+    } else {
+        bound
+    }
+}
+
 /// Sum of absolute coordinates.
 pub(crate) fn l1(p: &[f64; 3]) -> f64 {
     p[0].abs() + p[1].abs() + p[2].abs()

@@ -398,25 +398,6 @@ macro_rules! box_pair_methods {
                 .max_distance()
         }
 
-        /// For `x` in the box, `|a_i·(p − x)| ≥ |a_i·(p − c)| − h_i − tol·Σh` (axes
-        /// orthonormal within `tol`), and `|v| ≥ |A v| / (1 + 2 tol)`; the projections'
-        /// rounding is a few ulps of their terms.
-        fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
-            let (center, axes, half, frame_error) = self.local_box();
-            let d = nalgebra::Vector3::from(p) - center;
-            let local = axes * d;
-            let slack =
-                frame_error * half.sum() + 8.0 * f64::EPSILON * (d.abs().sum() + half.sum());
-            let excess = (local.abs() - half).map(|x| (x - slack).max(0.0));
-            // NaN (a damaged, unverified file) is "no bound".
-            let bound = excess.norm() * (1.0 - 4.0 * frame_error);
-            if bound.is_nan() {
-                0.0
-            } else {
-                bound
-            }
-        }
-
         fn world_aabb(&self, pose: &Pose) -> $crate::bv::Aabb<f64> {
             let (center, axes, half, frame_error) = self.local_box();
             $crate::bv::posed_box_aabb(&center, &axes, &half, frame_error, pose)

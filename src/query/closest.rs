@@ -115,11 +115,12 @@ pub fn closest_points(
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
+            // One heap per worker, reused point after point.
             self.points
                 .par_iter()
-                .map(|p| {
+                .map_init(BinaryHeap::new, |heap, p| {
                     let local = to_model.apply(&Vector3::from(*p));
-                    let found = descend(&tree, &local, self.options.max_distance)?;
+                    let found = descend(&tree, &local, self.options.max_distance, heap)?;
                     Ok(ClosestResult {
                         closest: found.best.map(|(face, point, feature)| ClosestPoint {
                             distance: found.distance,
@@ -169,12 +170,18 @@ struct Found {
     work: Work,
 }
 
-/// Best first: the node of smallest lower bound is expanded next, and the descent stops
-/// when that bound reaches the best distance found (every node waiting is at least as far).
+/// Dives and a heap, as the pair distance traversal does: each expansion continues with
+/// its nearest child down to a leaf (a first answer to prune with, one step per level), the
+/// other children wait on a heap, and the next dive starts from the nearest node waiting;
+/// the descent ends when that node's bound reaches the best distance found (every other
+/// waiting is at least as far). (Best first alone expanded the many boxes that all bound
+/// a point near the surface at 0 level by level before reaching any leaf; depth first
+/// alone opened half again as many boxes on the bunny.)
 fn descend<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     p: &Vector3<f64>,
     max_distance: f64,
+    heap: &mut BinaryHeap<Waiting>,
 ) -> Result<Found, QueryError> {
     let corrupt = |what| QueryError::CorruptTree {
         which: Side::A,
@@ -187,15 +194,15 @@ fn descend<B: BoundingVolume>(
     };
     let point = [p.x, p.y, p.z];
     let root = tree.node(0).ok_or(corrupt("node index out of bounds"))?;
-    let mut heap = BinaryHeap::new();
-    heap.push(Waiting {
+    heap.clear();
+    let mut dive = Some(Waiting {
         bound: root.bv.point_distance_lower_bound(point),
         node: 0,
     });
-    while let Some(Waiting { bound, node }) = heap.pop() {
+    while let Some(Waiting { bound, node }) = dive.take().or_else(|| heap.pop()) {
         found.work.nodes_visited += 1;
         if bound >= found.distance {
-            // It and every node still waiting are pruned.
+            // Taken from the heap: it and every node still waiting are pruned.
             found.work.bv_disjoint += 1 + heap.len() as u64;
             break;
         }
@@ -222,17 +229,26 @@ fn descend<B: BoundingVolume>(
             }
             // Children come after their parent (checked by `node_kind`): the descent
             // ends on any file.
-            NodeKind::Children(children) => {
-                for child in children {
+            NodeKind::Children(range) => {
+                for child in range {
                     let n = tree
                         .node(child)
                         .ok_or(corrupt("node index out of bounds"))?;
                     let bound = n.bv.point_distance_lower_bound(point);
-                    if bound < found.distance {
-                        heap.push(Waiting { bound, node: child });
-                    } else {
+                    if bound >= found.distance {
                         found.work.nodes_visited += 1;
                         found.work.bv_disjoint += 1;
+                        continue;
+                    }
+                    let waiting = Waiting { bound, node: child };
+                    // The nearest child continues the dive; the others wait.
+                    match dive {
+                        Some(d) if d.bound <= bound => heap.push(waiting),
+                        Some(d) => {
+                            heap.push(d);
+                            dive = Some(waiting);
+                        }
+                        None => dive = Some(waiting),
                     }
                 }
             }
