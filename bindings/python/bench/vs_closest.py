@@ -15,10 +15,12 @@ box three times the mesh's bounding box. Peers, each where it installs:
   query, done before the clock starts.
 
 obbtree answers from an f64 tree built in memory (`precision="f64"`), all points in one
-call. Every peer's distances must agree with obbtree's to 1e-9 relative (libigl) or 1e-5
-(Open3D, f32 storage); disagreements are printed and make the exit status 1. Times are the
-median of --repeat runs, on all cores unless limited (RAYON_NUM_THREADS for obbtree;
-libigl and Open3D use their own thread pools).
+call. libigl's distances (f64) must agree with obbtree's to 1e-9 relative: disagreements
+are printed and make the exit status 1. Open3D computes in f32, whose point-triangle
+arithmetic on long thin triangles can be off by far more than the coordinates' rounding:
+where it differs from obbtree by more than 1e-6 of the mesh's diagonal, the count is
+printed, for information. Times are the median of --repeat runs, on all cores unless
+limited (RAYON_NUM_THREADS for obbtree; libigl and Open3D use their own thread pools).
 """
 
 from __future__ import annotations
@@ -80,7 +82,7 @@ def median_seconds(run, repeat):
 
 class Igl:
     name = "libigl"
-    tolerance = 1e-9
+    exact = True
 
     def __init__(self):
         import igl  # noqa: F401
@@ -97,7 +99,7 @@ class Igl:
 
 class Open3d:
     name = "Open3D"
-    tolerance = 1e-5
+    exact = False
 
     def __init__(self):
         import open3d as o3d
@@ -144,6 +146,7 @@ def main():
         tree = obbtree.build(str(path), precision="f64")
         build_seconds = time.perf_counter() - built_at
         v, f = mesh_of(tree)
+        diagonal = float(np.linalg.norm(v.max(0) - v.min(0)))
         for peer in others:
             peer.prepare(v, f)
         for kind, points in query_points(v, f, args.points, rng).items():
@@ -151,12 +154,15 @@ def main():
             row = f"{name:<14} {kind:<5} {len(f):>9} {ours * 1e3:>8.1f}ms {build_seconds * 1e3:>7.1f}ms"
             for peer in others:
                 theirs, d = median_seconds(lambda: peer.distances(points), args.repeat)
-                bad = np.abs(d - answer.distance) > peer.tolerance * np.maximum(1.0, answer.distance)
+                allowed = 1e-9 * answer.distance if peer.exact else 1e-6 * diagonal
+                bad = np.abs(d - answer.distance) > allowed
                 if bad.any():
-                    disagreements += int(bad.sum())
                     i = int(np.argmax(bad))
-                    print(f"  {peer.name} disagrees at {int(bad.sum())} points, e.g. {points[i]}: "
+                    what = "disagrees" if peer.exact else "(f32) differs by more than 1e-6 of the diagonal"
+                    print(f"  {peer.name} {what} at {int(bad.sum())} points, e.g. {points[i]}: "
                           f"{d[i]!r} against {answer.distance[i]!r}", file=sys.stderr)
+                    if peer.exact:
+                        disagreements += int(bad.sum())
                 ratios[peer.name].append(ours / theirs)
                 row += f" {theirs * 1e3:>8.1f}ms {ours / theirs:>6.2f}"
             print(row)
