@@ -112,6 +112,9 @@ pub struct Trade {
     pub bv_tests: f64,
     /// The bytes of both models' tree files per triangle they hold.
     pub bytes_per_triangle: f64,
+    /// Whether the exact answer was asked for (every collision; a distance without an
+    /// error allowance or tolerance): what differs between such trades is the tree.
+    pub exact: bool,
     /// Whether no other choice of the same scene and query is at least as fast and at
     /// least as accurate (by the largest error), and better in one.
     pub pareto: bool,
@@ -129,6 +132,7 @@ impl Trade {
             error_max: 0.0,
             bv_tests: 0.0,
             bytes_per_triangle,
+            exact: true,
             pareto: false,
         }
     }
@@ -290,6 +294,7 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
         for &ask in asks {
             let choice = [choice.flags(), vec![ask.flag()]].concat().join(", ");
             let mut trade = Trade::new(&scene.name, "distance", choice, bytes_per_triangle);
+            trade.exact = matches!(ask, Ask::RelErr(r) if r == 0.0);
             for ([pa, pb], &d) in scene.apart.iter().zip(&distances) {
                 let ((found, tests), seconds) =
                     median_time(repeat, || -> Result<_, QueryError> {

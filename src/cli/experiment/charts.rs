@@ -392,8 +392,8 @@ impl TradeChart {
 }
 
 /// What size costs in time: for each scene and query, the time of every tree choice asked
-/// exactly against its trees' bytes per triangle, each point labelled with its choice (the
-/// answers are the exact ones, so only size and time differ).
+/// for the exact answer against its trees' bytes per triangle, each point labelled with its
+/// choice (what differs between them is the tree).
 pub fn size_chart(trades: &[Trade], scenes: &[Workload]) -> Chart<'static> {
     let mut all = Vec::new();
     for (colour, (scene, query)) in scenes
@@ -403,7 +403,7 @@ pub fn size_chart(trades: &[Trade], scenes: &[Workload]) -> Chart<'static> {
     {
         let exact: Vec<&Trade> = trades
             .iter()
-            .filter(|t| t.scene == scene.name && t.query == query && t.error_max == 0.0)
+            .filter(|t| t.scene == scene.name && t.query == query && t.exact)
             .collect();
         all.push(Series {
             name: format!("{} {query}", scene.name),
