@@ -30,7 +30,7 @@ pub struct CompactObb {
     /// Box centre, model frame.
     pub center: [f32; 3],
     /// The rotation whose columns are the box axes (axis 0 of greatest spread), as a
-    /// quaternion `w, x, y, z` scaled by [`QUATERNION_SCALE`].
+    /// quaternion `w, x, y, z`, each component times 32767.
     pub rotation: [i16; 4],
     /// Half-widths along the axes (model units, non-negative), as bfloat16 bit patterns.
     pub half: [u16; 3],
