@@ -126,7 +126,9 @@ impl<R: Real> BoundingVolume for Aabb<R> {
     #[inline]
     fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
-        // The excess past each face pair, in the model's exact axes: a few ulps of rounding.
+        // The excess past each face pair, from the stored min and max (not
+        // `box_point_distance_bound` on a centre derived from them, whose rounding is
+        // of their magnitude, not of the box's size): a few ulps of rounding.
         let mut sum = 0.0;
         for ((x, lo), hi) in p.iter().zip(lo).zip(hi) {
             let excess =

@@ -1,12 +1,11 @@
 //! `obbtree closest`: the closest point of one posed model to query points.
 
-use super::build::{build_with_progress, load_mesh, TreeArgs};
-use super::files::is_obbt;
+use super::build::TreeArgs;
 use super::poses::{parse_numbers, ModelPoseArgs};
 use super::print::out;
+use super::query::{is_tree_input, open_input};
 use super::{number, Failure, WithContext};
 use clap::Args;
-use obbtree::format::ObbtFile;
 use obbtree::query::{closest_points, ClosestOptions, ClosestResult};
 use serde_json::json;
 use std::io::Read;
@@ -110,25 +109,18 @@ fn query_points(args: &ClosestArgs) -> Result<Vec<[f64; 3]>, Failure> {
 pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
     let pose = args.pose.pose()?;
     let points = query_points(args)?;
-    let model = if is_obbt(&args.model)
-        || args
-            .model
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("obbt"))
-    {
+    if is_tree_input(&args.model) {
         if let Some(flag) = args.tree.given().first() {
             return Err(Failure::msg(format!(
                 "{flag} applies to mesh models only, and {} is a .obbt file",
                 args.model.display()
             )));
         }
-        ObbtFile::open(&args.model)?
-    } else {
-        let mesh = load_mesh(&args.model)?;
-        let options = args.tree.options();
-        options.validate()?;
-        build_with_progress(&mesh, &options, &args.model.display().to_string(), false)?
-    };
+    }
+    // Bad option values are reported before a (possibly large) mesh is read.
+    let tree_options = args.tree.options();
+    tree_options.validate()?;
+    let model = open_input(&args.model, &tree_options)?;
     let options = ClosestOptions {
         max_distance: args.max_distance.unwrap_or(f64::INFINITY),
     };
@@ -150,6 +142,12 @@ fn print_answer(
     many: bool,
 ) -> Result<(), Failure> {
     let work = &answer.work;
+    // Text lines name their point when there are several.
+    let prefix = if many {
+        format!("point {index}: ")
+    } else {
+        String::new()
+    };
     match (&answer.closest, args.csv, args.json) {
         (Some(c), true, _) => out!(
             "{index},{},{},{},{},{},{},{},{},{}",
@@ -178,37 +176,23 @@ fn print_answer(
             });
             out!("{object}")?;
         }
-        (Some(c), false, false) => {
-            let prefix = if many {
-                format!("point {index}: ")
-            } else {
-                String::new()
-            };
-            out!(
-                "{prefix}distance {} to ({}, {}, {}) on triangle {} ({} {}); bv tests {}, triangle tests {}",
-                number(c.distance),
-                number(c.point[0]),
-                number(c.point[1]),
-                number(c.point[2]),
-                c.triangle,
-                c.feature.name(),
-                c.feature.index(),
-                work.bv_tests(),
-                work.tri_tests()
-            )?;
-        }
-        (None, false, false) => {
-            let prefix = if many {
-                format!("point {index}: ")
-            } else {
-                String::new()
-            };
-            out!(
-                "{prefix}nothing within {}; bv tests {}",
-                number(args.max_distance.unwrap_or(f64::INFINITY)),
-                work.bv_tests()
-            )?;
-        }
+        (Some(c), false, false) => out!(
+            "{prefix}distance {} to ({}, {}, {}) on triangle {} ({} {}); bv tests {}, triangle tests {}",
+            number(c.distance),
+            number(c.point[0]),
+            number(c.point[1]),
+            number(c.point[2]),
+            c.triangle,
+            c.feature.name(),
+            c.feature.index(),
+            work.bv_tests(),
+            work.tri_tests()
+        )?,
+        (None, false, false) => out!(
+            "{prefix}nothing within {}; bv tests {}",
+            number(args.max_distance.unwrap_or(f64::INFINITY)),
+            work.bv_tests()
+        )?,
     }
     Ok(())
 }

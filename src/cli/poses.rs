@@ -55,16 +55,15 @@ pub struct ModelPoseArgs {
 impl ModelPoseArgs {
     /// The pose of --pose (identity without it).
     pub fn pose(&self) -> Result<Pose, Failure> {
-        let Some(text) = self.pose.as_deref() else {
-            return Ok(Pose::identity());
-        };
-        let parsed = self
-            .pose_format
-            .format()
-            .parse(&parse_numbers(text, "--pose")?, self.orthonormalize)
-            .with_context(|| "--pose")?;
         let mut repairs = Repairs::default();
-        let pose = repairs.note(&parsed, || "--pose".to_string());
+        let format = self.pose_format.format();
+        let pose = flag_pose(
+            self.pose.as_deref(),
+            "--pose",
+            format,
+            self.orthonormalize,
+            &mut repairs,
+        )?;
         repairs.report("--pose");
         Ok(pose)
     }
@@ -107,6 +106,24 @@ pub fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>, Failure> {
                 .map_err(|_| Failure::msg(format!("{what}: value {i} ({t:?}) is not a number")))
         })
         .collect()
+}
+
+/// The pose given by `flag` (`text`, in `format`; the identity without it), its repair
+/// noted in `repairs`.
+fn flag_pose(
+    text: Option<&str>,
+    flag: &str,
+    format: PoseFormat,
+    repair: bool,
+    repairs: &mut Repairs,
+) -> Result<Pose, Failure> {
+    let Some(text) = text else {
+        return Ok(Pose::identity());
+    };
+    let parsed = format
+        .parse(&parse_numbers(text, flag)?, repair)
+        .with_context(|| flag)?;
+    Ok(repairs.note(&parsed, || flag.to_string()))
 }
 
 /// The repairs made while reading poses, reported once on stderr.
@@ -152,17 +169,21 @@ impl PoseArgs {
     /// The pose pair of --pose-a / --pose-b (identity where absent).
     pub fn single(&self) -> Result<(Pose, Pose), Failure> {
         let mut repairs = Repairs::default();
-        let mut one = |text: Option<&str>, flag: &str| -> Result<Pose, Failure> {
-            let Some(text) = text else {
-                return Ok(Pose::identity());
-            };
-            let parsed = self
-                .parse(&parse_numbers(text, flag)?)
-                .with_context(|| flag)?;
-            Ok(repairs.note(&parsed, || flag.to_string()))
-        };
-        let a = one(self.pose_a.as_deref(), "--pose-a")?;
-        let b = one(self.pose_b.as_deref(), "--pose-b")?;
+        let (format, repair) = (self.pose_format.format(), self.orthonormalize);
+        let a = flag_pose(
+            self.pose_a.as_deref(),
+            "--pose-a",
+            format,
+            repair,
+            &mut repairs,
+        )?;
+        let b = flag_pose(
+            self.pose_b.as_deref(),
+            "--pose-b",
+            format,
+            repair,
+            &mut repairs,
+        )?;
         repairs.report("--pose-a/--pose-b");
         Ok((a, b))
     }

@@ -160,7 +160,7 @@ pub struct SpanArgs {
 /// Whether an input is to be read as a tree: it starts with the `.obbt` signature, or it
 /// is named `*.obbt` (so a damaged or empty one gets the reader's error, such as
 /// "truncated", not the mesh loader's "unknown mesh format").
-fn is_tree_input(path: &Path) -> bool {
+pub(super) fn is_tree_input(path: &Path) -> bool {
     is_obbt(path)
         || path
             .extension()
@@ -168,7 +168,7 @@ fn is_tree_input(path: &Path) -> bool {
 }
 
 /// Opens a .obbt file, or loads and builds a mesh with `options`.
-fn open_input(path: &Path, options: &BuildOptions) -> Result<ObbtFile, Failure> {
+pub(super) fn open_input(path: &Path, options: &BuildOptions) -> Result<ObbtFile, Failure> {
     if is_tree_input(path) {
         return Ok(ObbtFile::open(path)?);
     }

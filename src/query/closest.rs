@@ -1,12 +1,13 @@
 //! The closest point of one posed model to query points: a best-first descent of one tree,
 //! pruned by each volume's lower bound on its distance to the point.
 
+use super::engine::{corrupt, triangle};
 use super::triangle::{closest_point_on_triangle, Feature};
 use super::{source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
-use crate::tree::{NodeKind, TreeView};
+use crate::tree::{NodeDefect, NodeKind, TreeView};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -183,17 +184,13 @@ fn descend<B: BoundingVolume>(
     max_distance: f64,
     heap: &mut BinaryHeap<Waiting>,
 ) -> Result<Found, QueryError> {
-    let corrupt = |what| QueryError::CorruptTree {
-        which: Side::A,
-        what,
-    };
     let mut found = Found {
         best: None,
         distance: max_distance,
         work: Work::default(),
     };
     let point = [p.x, p.y, p.z];
-    let root = tree.node(0).ok_or(corrupt("node index out of bounds"))?;
+    let root = tree.node(0).ok_or(corrupt(Side::A, NodeDefect::Missing))?;
     heap.clear();
     let mut dive = Some(Waiting {
         bound: root.bv.point_distance_lower_bound(point),
@@ -207,13 +204,10 @@ fn descend<B: BoundingVolume>(
             break;
         }
         found.work.bv_overlap += 1;
-        match tree.node_kind(node).map_err(|d| corrupt(d.describe()))? {
+        match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
             NodeKind::Faces(faces) => {
                 for face in faces {
-                    let t = tree
-                        .triangle(face)
-                        .ok_or(corrupt("face or vertex index out of bounds"))?
-                        .map(Vector3::from);
+                    let t = triangle(tree, face, None, Side::A)?;
                     let (q, feature) = closest_point_on_triangle(p, &t);
                     let d = (p - q).norm();
                     if d == 0.0 {
@@ -233,7 +227,7 @@ fn descend<B: BoundingVolume>(
                 for child in range {
                     let n = tree
                         .node(child)
-                        .ok_or(corrupt("node index out of bounds"))?;
+                        .ok_or(corrupt(Side::A, NodeDefect::Missing))?;
                     let bound = n.bv.point_distance_lower_bound(point);
                     if bound >= found.distance {
                         found.work.nodes_visited += 1;

@@ -214,7 +214,7 @@ impl QueryContext {
 
 /// Reads triangle `face` of `tree`, mapped into A's frame by `b_to_a` (`None` for A's own).
 #[inline]
-fn triangle<B: BoundingVolume>(
+pub(super) fn triangle<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     face: u32,
     b_to_a: Option<&Pose>,
@@ -274,7 +274,7 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
     }
 }
 
-fn corrupt(which: Side, defect: NodeDefect) -> QueryError {
+pub(super) fn corrupt(which: Side, defect: NodeDefect) -> QueryError {
     QueryError::CorruptTree {
         which,
         what: defect.describe(),
