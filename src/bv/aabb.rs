@@ -145,6 +145,30 @@ impl<R: Real> BoundingVolume for Aabb<R> {
         }
     }
 
+    #[inline]
+    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
+        let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
+        let (mut near, mut far) = (0.0f64, t_max);
+        for k in 0..3 {
+            let (o, q) = (origin[k], direction[k]);
+            // A few ulps of slack on each face, as for the point bound.
+            let slack = 4.0 * f64::EPSILON * (o.abs() + lo[k].abs() + hi[k].abs());
+            let (lo, hi) = (lo[k] - slack, hi[k] + slack);
+            if q == 0.0 {
+                if o < lo || o > hi {
+                    return None;
+                }
+                continue;
+            }
+            let (t0, t1) = ((lo - o) / q, (hi - o) / q);
+            let (a, b) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+            // (`max` and `min` skip a NaN operand: a damaged box prunes nothing.)
+            near = near.max(a - 4.0 * f64::EPSILON * a.abs());
+            far = far.min(b + 4.0 * f64::EPSILON * b.abs());
+        }
+        (near <= far).then_some(near)
+    }
+
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
         arr3::zip(p, arr3::zip(lo, hi))

@@ -218,6 +218,10 @@ impl BoundingVolume for CompactObb {
         self.decode().point_distance_lower_bound(p)
     }
 
+    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
+        self.decode().ray_entry(origin, direction, t_max)
+    }
+
     fn world_aabb(&self, pose: &Pose) -> super::Aabb<f64> {
         self.decode().world_aabb(pose)
     }

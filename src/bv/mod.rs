@@ -390,6 +390,12 @@ pub trait BoundingVolume:
     /// frame's error and for rounding; 0 for a damaged volume.
     fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64;
 
+    /// The smallest ray parameter in `[0, t_max]` at which the model-frame ray
+    /// `origin + t · direction` may be inside the volume, or `None` when no point of that
+    /// segment is: what a ray query prunes and orders with. Conservative for the stored
+    /// frame's error and for rounding; never `None` for a damaged volume.
+    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64>;
+
     /// An axis-aligned box containing this volume once mapped by `pose` (a model's pose: the
     /// box is in world coordinates): the broad phase of scenes bounds each posed model by
     /// the world box of its root volume, with no traversal. Conservative: widened for the
@@ -529,6 +535,42 @@ pub(crate) fn box_point_distance_bound(
     } else {
         bound
     }
+}
+
+/// [`BoundingVolume::ray_entry`] of a stored box: `d` is the ray's origin less the box's
+/// centre, `axes` the stored rows, `half` the half-widths. A slab test, which needs no
+/// orthogonal axes: each slab is widened as [`box_point_distance_bound`] widens it, and by
+/// the rounding of the projections (a point of the box lies within about
+/// `|d| + Σ half` of the origin, which bounds `t · |direction|` there), and each crossing
+/// parameter by its own rounding. NaN (a damaged, unverified file) prunes nothing.
+#[inline(always)]
+pub(crate) fn box_ray_entry(
+    d: [f64; 3],
+    direction: [f64; 3],
+    axes: &[[f64; 3]; 3],
+    half: [f64; 3],
+    frame_error: f64,
+    t_max: f64,
+) -> Option<f64> {
+    let half_sum = half[0] + half[1] + half[2];
+    let slack = frame_error * half_sum + 16.0 * f64::EPSILON * (l1(&d) + half_sum);
+    let (mut near, mut far) = (0.0f64, t_max);
+    for (axis, h) in axes.iter().zip(half) {
+        let (p, q) = (arr3::dot(*axis, d), arr3::dot(*axis, direction));
+        let h = h + slack;
+        if q == 0.0 {
+            if p.abs() > h {
+                return None;
+            }
+            continue;
+        }
+        let (t0, t1) = ((-h - p) / q, (h - p) / q);
+        let (lo, hi) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+        // (`max` and `min` skip a NaN operand.)
+        near = near.max(lo - 4.0 * f64::EPSILON * lo.abs());
+        far = far.min(hi + 4.0 * f64::EPSILON * hi.abs());
+    }
+    (near <= far).then_some(near)
 }
 
 /// Sum of absolute coordinates.

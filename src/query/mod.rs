@@ -33,6 +33,7 @@ pub mod details;
 mod distance;
 mod engine;
 mod pair_query;
+mod ray;
 mod span;
 pub mod triangle;
 mod work;
@@ -47,6 +48,7 @@ pub use distance::{
 };
 pub use engine::QueryContext;
 pub use pair_query::PairQuery;
+pub use ray::{all_ray_hits, cast_rays, Ray, RayHit, RayHits, RayMode, RayOptions, RayResult};
 pub use span::{SpanOptions, SpanResult};
 pub use work::Work;
 
@@ -96,6 +98,18 @@ pub enum QueryError {
         /// What it must be.
         requirement: &'static str,
         /// The value given.
+        value: f64,
+    },
+    /// One query of a batch (a ray, a point) is unusable.
+    #[error("{what} {index}: {requirement}, got {value}")]
+    BadInput {
+        /// What it is: `ray`, `query point`.
+        what: &'static str,
+        /// Its index in the batch.
+        index: usize,
+        /// What it must be.
+        requirement: &'static str,
+        /// The offending value.
         value: f64,
     },
     /// A file's sections could not be viewed as a tree.

@@ -28,6 +28,7 @@ mod layouts;
 mod mesh_loaders;
 mod poses;
 mod queries;
+mod rays;
 mod scene_broad;
 mod scene_cli;
 mod scene_equivalence;

@@ -1,0 +1,212 @@
+//! Where a ray meets a triangle: watertight, with exact edge signs.
+//!
+//! Woop, Benthin and Wald's test ("Watertight Ray/Triangle Intersection", JCGT 2013): every
+//! corner is moved into the ray's frame, sheared so the ray is the +z axis, and the ray
+//! meets the triangle where the three 2D edge functions at the origin agree in sign. A
+//! corner's sheared coordinates depend only on the corner and the ray, so two triangles
+//! sharing an edge see it identically; the edge functions' signs are then taken exactly
+//! (Shewchuk's orient2d when the float value is too small to trust), so no ray slips
+//! between them. A ray exactly on an edge or a corner belongs to one triangle only, by a
+//! tie rule that is a symbolic perturbation of the ray (see [`owns`]).
+
+use super::predicates::orient2d;
+use super::Triangle;
+use nalgebra::Vector3;
+
+/// A ray prepared for triangle tests: its origin and the shear that maps its direction to
+/// +z. Made once per ray, used for every triangle.
+#[derive(Clone, Copy, Debug)]
+pub struct RaySpace {
+    origin: Vector3<f64>,
+    /// The coordinates that become the sheared x, y and z.
+    axes: [usize; 3],
+    /// `d[kx] / d[kz]`, `d[ky] / d[kz]` and `1 / d[kz]`.
+    shear: [f64; 3],
+}
+
+/// Where a ray meets a triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayTriangleHit {
+    /// The ray parameter: the point is `origin + t · direction`.
+    pub t: f64,
+    /// The point's weights on the triangle's three corners (non-negative, summing to 1).
+    pub barycentric: [f64; 3],
+}
+
+impl RaySpace {
+    /// The ray from `origin` along `direction`, or `None` when the direction is zero or
+    /// either is not finite.
+    pub fn new(origin: &Vector3<f64>, direction: &Vector3<f64>) -> Option<RaySpace> {
+        if !origin.iter().chain(direction.iter()).all(|x| x.is_finite()) {
+            return None;
+        }
+        let kz = direction.iamax();
+        if direction[kz] == 0.0 {
+            return None;
+        }
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        // Keeps the sheared frame right-handed, so a triangle's 2D winding is its facing.
+        if direction[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = direction[kz];
+        Some(RaySpace {
+            origin: *origin,
+            axes: [kx, ky, kz],
+            shear: [direction[kx] / dz, direction[ky] / dz, 1.0 / dz],
+        })
+    }
+
+    /// A corner in the ray's sheared frame: the ray is the +z axis, and `z` is the ray
+    /// parameter of the corner's projection onto it.
+    #[inline(always)]
+    fn sheared(&self, p: &Vector3<f64>) -> [f64; 3] {
+        let [kx, ky, kz] = self.axes;
+        let d = p - self.origin;
+        [
+            d[kx] - self.shear[0] * d[kz],
+            d[ky] - self.shear[1] * d[kz],
+            self.shear[2] * d[kz],
+        ]
+    }
+
+    /// Where the ray meets closed triangle `t` with a parameter in `[0, t_max]`, if it
+    /// does. A ray in the triangle's plane, or a triangle whose corners are collinear as
+    /// the ray sees them, is a miss. On an edge shared by two triangles on either side of
+    /// it (as the ray sees them) exactly one of them is hit; at a corner, one of the
+    /// triangles around it.
+    #[inline]
+    pub fn intersect(&self, t: &Triangle, t_max: f64) -> Option<RayTriangleHit> {
+        let [a, b, c] = t.map(|p| self.sheared(&p));
+        // Each function is twice the signed area the origin makes with an edge, so the one
+        // of the edge opposite a corner is that corner's weight.
+        let u = cross(&c, &b);
+        let v = cross(&a, &c);
+        let w = cross(&b, &a);
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        // The origin lies on the line of every edge whose function is zero: the triangle
+        // keeps that edge only if it owns it. With `det > 0` the triangle lies to the right
+        // of a→b→c, so each edge is taken reversed to have the triangle on its left.
+        let on_left = |p: &[f64; 3], q: &[f64; 3]| if det < 0.0 { owns(p, q) } else { owns(q, p) };
+        if (u == 0.0 && !on_left(&b, &c))
+            || (v == 0.0 && !on_left(&c, &a))
+            || (w == 0.0 && !on_left(&a, &b))
+        {
+            return None;
+        }
+        let t_hit = (u * a[2] + v * b[2] + w * c[2]) / det;
+        // (Also refuses NaN, from coordinates so large that products overflow.)
+        if !(t_hit >= 0.0 && t_hit <= t_max) {
+            return None;
+        }
+        Some(RayTriangleHit {
+            t: t_hit,
+            barycentric: [u / det, v / det, w / det],
+        })
+    }
+}
+
+/// `p.x q.y − p.y q.x` for sheared corners, with its sign exact: the float value when
+/// its rounding cannot change the sign, else Shewchuk's adaptive orient2d.
+#[inline(always)]
+fn cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+    let (l, r) = (p[0] * q[1], p[1] * q[0]);
+    let value = l - r;
+    // Shewchuk's first error bound for orient2d, (3 + 16ε)ε of the terms' magnitudes.
+    const BOUND: f64 = (3.0 + 16.0 * f64::EPSILON) * f64::EPSILON / 2.0;
+    // (Products near underflow lose their relative error bound: exact then too.)
+    let terms = l.abs() + r.abs();
+    if value.abs() > BOUND * terms && terms > 1e-280 {
+        value
+    } else {
+        // orient2d(0, p, q) is p × q.
+        orient2d([0.0, 0.0], [p[0], p[1]], [q[0], q[1]])
+    }
+}
+
+/// Whether the directed edge `p → q` (with its triangle on its left) owns the points of
+/// it: those whose direction is upward, or horizontal and leftward. Of an edge's two
+/// directions exactly one does, so of two triangles on either side of an edge exactly one
+/// keeps it. This is the side a point nudged by `(−η, −η²)`, for a vanishing η, falls on,
+/// so at a corner too exactly one of the triangles around it (seen from the ray) keeps the
+/// point. A zero-length edge owns nothing.
+#[inline(always)]
+fn owns(p: &[f64; 3], q: &[f64; 3]) -> bool {
+    // The signs of these differences are exact.
+    let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+    dy > 0.0 || (dy == 0.0 && dx < 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64, z: f64) -> Vector3<f64> {
+        Vector3::new(x, y, z)
+    }
+
+    #[test]
+    fn hits_the_middle_with_its_weights() {
+        let ray = RaySpace::new(&v(0.25, 0.25, 5.0), &v(0.0, 0.0, -2.0)).unwrap();
+        let tri = [v(0.0, 0.0, 1.0), v(1.0, 0.0, 1.0), v(0.0, 1.0, 1.0)];
+        let hit = ray.intersect(&tri, f64::INFINITY).unwrap();
+        assert_eq!(hit.t, 2.0);
+        assert_eq!(hit.barycentric, [0.5, 0.25, 0.25]);
+        assert!(ray.intersect(&tri, 1.5).is_none());
+        let behind = RaySpace::new(&v(0.25, 0.25, 5.0), &v(0.0, 0.0, 1.0)).unwrap();
+        assert!(behind.intersect(&tri, f64::INFINITY).is_none());
+    }
+
+    #[test]
+    fn a_shared_edge_and_corner_are_hit_once() {
+        // A square of two triangles and a fan of four around the centre.
+        let sq = [
+            v(0.0, 0.0, 0.0),
+            v(1.0, 0.0, 0.0),
+            v(1.0, 1.0, 0.0),
+            v(0.0, 1.0, 0.0),
+        ];
+        let square = [[sq[0], sq[1], sq[2]], [sq[0], sq[2], sq[3]]];
+        let m = v(0.5, 0.5, 0.0);
+        let fan: Vec<Triangle> = (0..4).map(|k| [m, sq[k], sq[(k + 1) % 4]]).collect();
+        for dir in [v(0.0, 0.0, -1.0), v(0.0, 0.0, 1.0), v(0.3, -0.2, -1.0)] {
+            let hits = |tris: &[Triangle], at: Vector3<f64>| {
+                let ray = RaySpace::new(&(at - dir * 3.0), &dir).unwrap();
+                tris.iter()
+                    .filter(|t| ray.intersect(t, f64::INFINITY).is_some())
+                    .count()
+            };
+            // Inside the diagonal: once; at its ends, on the square's border, at most once
+            // (the perturbed ray may pass outside).
+            for s in [0.25, 0.5] {
+                assert_eq!(hits(&square, v(s, s, 0.0)), 1, "diagonal at {s}, {dir:?}");
+            }
+            for s in [0.0, 1.0] {
+                assert!(hits(&square, v(s, s, 0.0)) <= 1, "corner {s}, {dir:?}");
+            }
+            assert_eq!(hits(&fan, m), 1, "centre of the fan, {dir:?}");
+        }
+    }
+
+    #[test]
+    fn edge_signs_are_exact_where_the_float_product_rounds_to_zero() {
+        // (1 + 2⁻⁵²)(1 − 2⁻⁵²) − 1 = −2⁻¹⁰⁴, which rounds to 0 in f64.
+        let (x, y) = (1.0 + f64::EPSILON, 1.0 - f64::EPSILON);
+        assert_eq!(x * y - 1.0, 0.0);
+        assert!(cross(&[x, 1.0, 0.0], &[1.0, y, 0.0]) < 0.0);
+        assert!(cross(&[1.0, y, 0.0], &[x, 1.0, 0.0]) > 0.0);
+    }
+
+    #[test]
+    fn refuses_zero_and_non_finite_directions() {
+        assert!(RaySpace::new(&v(0.0, 0.0, 0.0), &v(0.0, 0.0, 0.0)).is_none());
+        assert!(RaySpace::new(&v(0.0, 0.0, 0.0), &v(f64::NAN, 0.0, 1.0)).is_none());
+        assert!(RaySpace::new(&v(f64::INFINITY, 0.0, 0.0), &v(0.0, 0.0, 1.0)).is_none());
+    }
+}

@@ -1,0 +1,394 @@
+//! Rays against one posed model (`query::cast_rays`, `query::all_ray_hits`): the traversal
+//! against brute force over every triangle, the triangle test against an independent one
+//! (Möller–Trumbore) away from edges, and watertightness on closed meshes with rays aimed
+//! exactly at corners and edges.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
+
+use crate::common;
+
+use nalgebra::Vector3;
+use obbtree::build::build;
+use obbtree::format::ObbtFile;
+use obbtree::generate::Rng;
+use obbtree::mesh::TriMesh;
+use obbtree::query::triangle::RaySpace;
+use obbtree::query::{all_ray_hits, cast_rays, Pose, QueryError, Ray, RayHit, RayMode, RayOptions};
+
+type Tri = [[f64; 3]; 3];
+
+/// Rays at `triangles` (model frame) posed by `pose`: aimed at corners, edge midpoints and
+/// jittered centroids from outside, grazing along edges, from inside the model, and
+/// random ones that mostly miss.
+fn rays_at(triangles: &[(u32, Tri)], pose: &Pose, rng: &mut Rng) -> Vec<Ray> {
+    let mut out = Vec::new();
+    for k in 0..80 {
+        let (_, t) = triangles[rng.below(triangles.len())];
+        let [a, b, c] = t.map(Vector3::from);
+        let mut random = |r: f64| Vector3::new(rng.signed(), rng.signed(), rng.signed()) * r;
+        let from = random(4.0);
+        let (origin, target) = match k % 6 {
+            0 => (from, a),
+            1 => (from, (a + b) / 2.0),
+            2 => (from, (a + b + c) / 3.0 + random(0.02)),
+            // Along an edge: grazing the surface.
+            3 => (a - (b - a) * 2.0, b),
+            // From the model's middle outwards.
+            4 => (random(0.05), (a + b + c) / 3.0),
+            _ => (from, random(4.0)),
+        };
+        let direction = target - origin;
+        if direction.norm() == 0.0 {
+            continue;
+        }
+        out.push(Ray {
+            origin: pose.apply(&origin).into(),
+            direction: (pose.rotation() * direction).into(),
+        });
+    }
+    out
+}
+
+/// Every hit of `ray` on `triangles`, one triangle at a time, in the model frame the
+/// library maps the ray into; sorted by `t`, then id.
+fn brute_hits(triangles: &[(u32, Tri)], pose: &Pose, ray: &Ray, t_max: f64) -> Vec<(f64, u32)> {
+    let to_model = Pose::relative(pose, &Pose::identity());
+    let origin = to_model.apply(&Vector3::from(ray.origin));
+    let direction = to_model.rotation() * Vector3::from(ray.direction);
+    let space = RaySpace::new(&origin, &direction).expect("a valid ray");
+    let mut hits: Vec<(f64, u32)> = triangles
+        .iter()
+        .filter_map(|(id, t)| Some((space.intersect(&t.map(Vector3::from), t_max)?.t, *id)))
+        .collect();
+    hits.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    hits
+}
+
+/// A hit's geometry agrees with itself: the barycentric point is the ray's point at `t`,
+/// and the normal is the named triangle's, posed.
+fn assert_consistent(hit: &RayHit, ray: &Ray, triangles: &[(u32, Tri)], pose: &Pose, what: &str) {
+    let (_, t) = triangles
+        .iter()
+        .find(|(id, _)| *id == hit.triangle)
+        .expect("a triangle id");
+    let [a, b, c] = t.map(|p| pose.apply(&Vector3::from(p)));
+    let w = hit.barycentric;
+    assert!(w.iter().all(|x| *x >= 0.0), "{what}: weights {w:?}");
+    assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{what}");
+    let on = a * w[0] + b * w[1] + c * w[2];
+    let at = Vector3::from(ray.at(hit.t));
+    let scale = 1.0 + at.norm() + Vector3::from(ray.origin).norm();
+    assert!((on - at).norm() <= 1e-9 * scale, "{what}: {on:?} vs {at:?}");
+    let n = (b - a).cross(&(c - a));
+    if n.norm() > 1e-12 {
+        assert!(
+            (n.normalize() - Vector3::from(hit.normal)).norm() < 1e-9,
+            "{what}"
+        );
+    }
+}
+
+#[test]
+fn closest_any_and_all_hits_match_brute_force_for_every_tree_type() {
+    let cow = common::cow();
+    let mut rng = Rng::new(21);
+    for options in common::all_options() {
+        let file = build(&cow, &options, None).expect("builds");
+        let triangles = common::file_triangles(&file);
+        for seed in 0..2 {
+            let pose = common::turned_pose(seed, 0.7);
+            let rays = rays_at(&triangles, &pose, &mut rng);
+            let closest = cast_rays(&file, &pose, &rays, &RayOptions::default()).expect("answers");
+            let all = all_ray_hits(&file, &pose, &rays, f64::INFINITY).expect("answers");
+            let t_max = 1.5;
+            let any = cast_rays(
+                &file,
+                &pose,
+                &rays,
+                &RayOptions {
+                    mode: RayMode::Any,
+                    t_max,
+                },
+            )
+            .expect("answers");
+            for (k, ray) in rays.iter().enumerate() {
+                let what = format!("{options:?} seed {seed} ray {k} {ray:?}");
+                let brute = brute_hits(&triangles, &pose, ray, f64::INFINITY);
+                // Ties: the smallest input id among equal `t`.
+                let first = closest[k].hit.map(|h| (h.t, h.triangle));
+                assert_eq!(first, brute.first().copied(), "{what}");
+                let every: Vec<(f64, u32)> =
+                    all[k].hits.iter().map(|h| (h.t, h.triangle)).collect();
+                assert_eq!(every, brute, "{what}");
+                for hit in closest[k].hit.iter().chain(&all[k].hits) {
+                    assert_consistent(hit, ray, &triangles, &pose, &what);
+                }
+                let within = brute_hits(&triangles, &pose, ray, t_max);
+                match any[k].hit {
+                    Some(h) => assert!(within.contains(&(h.t, h.triangle)), "{what}"),
+                    None => assert!(within.is_empty(), "{what}"),
+                }
+            }
+        }
+    }
+}
+
+/// Möller–Trumbore's test, for rays clearly inside or outside a triangle: the weights of
+/// corners 1 and 2 and the ray parameter.
+fn moller_trumbore(o: &Vector3<f64>, d: &Vector3<f64>, t: &Tri) -> Option<(f64, f64, f64)> {
+    let [a, b, c] = t.map(Vector3::from);
+    let (e1, e2) = (b - a, c - a);
+    let p = d.cross(&e2);
+    let det = e1.dot(&p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let s = o - a;
+    let u = s.dot(&p) / det;
+    let q = s.cross(&e1);
+    let v = d.dot(&q) / det;
+    Some((u, v, e2.dot(&q) / det))
+}
+
+#[test]
+fn the_triangle_test_agrees_with_moller_trumbore_away_from_edges() {
+    let mut rng = Rng::new(5);
+    let mut checked = 0;
+    for _ in 0..20_000 {
+        let mut point = || Vector3::new(rng.signed(), rng.signed(), rng.signed());
+        let t: Tri = [point().into(), point().into(), point().into()];
+        let (o, d) = (point() * 3.0, point());
+        let Some(space) = RaySpace::new(&o, &d) else {
+            continue;
+        };
+        let Some((u, v, t_mt)) = moller_trumbore(&o, &d, &t) else {
+            continue;
+        };
+        let margin = 1e-7;
+        let inside = u > margin && v > margin && u + v < 1.0 - margin && t_mt > margin;
+        let outside = u < -margin || v < -margin || u + v > 1.0 + margin || t_mt < -margin;
+        let hit = space.intersect(&t.map(Vector3::from), f64::INFINITY);
+        if inside {
+            let hit = hit.expect("Möller–Trumbore hits");
+            assert!(
+                (hit.t - t_mt).abs() <= 1e-9 * (1.0 + t_mt),
+                "{} vs {t_mt}",
+                hit.t
+            );
+            assert!((hit.barycentric[1] - u).abs() < 1e-9 && (hit.barycentric[2] - v).abs() < 1e-9);
+            checked += 1;
+        } else if outside {
+            assert!(hit.is_none(), "Möller–Trumbore misses: {t:?} {o:?} {d:?}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 15_000, "{checked}");
+}
+
+/// Every corner and edge midpoint of `triangles`, exactly (the stored coordinates, so f32
+/// trees are aimed at exactly too).
+fn corners_and_midpoints(triangles: &[(u32, Tri)]) -> Vec<Vector3<f64>> {
+    let mut out = Vec::new();
+    for (_, t) in triangles {
+        for k in 0..3 {
+            let (a, b) = (Vector3::from(t[k]), Vector3::from(t[(k + 1) % 3]));
+            out.extend([a, (a + b) / 2.0]);
+        }
+    }
+    out
+}
+
+/// Whether `p` is strictly inside the convex polyhedron of outward-facing `triangles`.
+fn inside_convex(triangles: &[(u32, Tri)], p: &Vector3<f64>) -> bool {
+    triangles.iter().all(|(_, t)| {
+        let [a, b, c] = t.map(Vector3::from);
+        (p - a).dot(&(b - a).cross(&(c - a))) < -1e-12
+    })
+}
+
+/// Closed convex meshes: a ray from outside aimed exactly at a corner or an edge crosses
+/// the surface an even number of times (none when it only touches the surface there),
+/// from inside an odd number of times, and a ray that enters the interior through the
+/// corner or edge hits it there. A ray slipping between two triangles, or hitting an edge
+/// twice, breaks one of these.
+#[test]
+fn rays_through_corners_and_edges_of_closed_meshes_are_watertight() {
+    let meshes = [
+        ("cube", common::cube(0.5)),
+        ("sphere", common::uv_sphere(1.0, 12, 16)),
+        (
+            "cuboid",
+            common::cuboid([0.5, 1.0, 0.25], [0.125, -0.5, 0.0]),
+        ),
+    ];
+    let mut rng = Rng::new(8);
+    for (name, mesh) in meshes {
+        for options in common::all_options() {
+            let file = build(&mesh, &options, None).expect("builds");
+            let triangles = common::file_triangles(&file);
+            let pose = Pose::identity();
+            let mut rays = Vec::new();
+            for target in corners_and_midpoints(&triangles) {
+                // From outside: along the axes and diagonals (exact directions) and
+                // random ones; from the centre.
+                let mut origins = vec![
+                    target + Vector3::new(4.0, 0.0, 0.0),
+                    target + Vector3::new(0.0, 0.0, -4.0),
+                    target + Vector3::new(3.0, 3.0, 3.0),
+                    target + Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 5.0,
+                ];
+                origins.retain(|o| o.norm() > 2.5);
+                for origin in origins {
+                    let enters = inside_convex(&triangles, &(target + (target - origin) * 1e-4));
+                    rays.push((
+                        false,
+                        enters,
+                        Ray {
+                            origin: origin.into(),
+                            direction: (target - origin).into(),
+                        },
+                    ));
+                }
+                let centre = Vector3::new(0.01, -0.02, 0.015)
+                    + mesh
+                        .vertices()
+                        .iter()
+                        .map(|p| Vector3::from(*p))
+                        .sum::<Vector3<f64>>()
+                        / mesh.vertices().len() as f64;
+                rays.push((
+                    true,
+                    true,
+                    Ray {
+                        origin: centre.into(),
+                        direction: (target - centre).into(),
+                    },
+                ));
+            }
+            let only: Vec<Ray> = rays.iter().map(|(_, _, r)| *r).collect();
+            let all = all_ray_hits(&file, &pose, &only, f64::INFINITY).expect("answers");
+            let closest = cast_rays(&file, &pose, &only, &RayOptions::default()).expect("answers");
+            let mut entering = 0;
+            for (((inside, enters, ray), hits), first) in rays.iter().zip(&all).zip(&closest) {
+                let what = format!("{name} {options:?} {ray:?}: {:?}", hits.hits);
+                assert_eq!(hits.hits.len() % 2 == 1, *inside, "{what}");
+                assert_eq!(first.hit.is_some(), !hits.hits.is_empty(), "{what}");
+                if *enters && !*inside {
+                    // Hit at the aimed point (t = 1) or before it.
+                    let t = first.hit.map(|h| h.t).expect(&what);
+                    assert!(t <= 1.0 + 1e-12, "{what}");
+                    entering += 1;
+                }
+            }
+            assert!(entering > 20, "{name}: {entering} rays enter");
+        }
+    }
+}
+
+#[test]
+fn bad_rays_and_limits_are_refused_naming_the_ray() {
+    let file = build(&common::cube(0.5), &Default::default(), None).expect("builds");
+    let pose = Pose::identity();
+    let good = Ray {
+        origin: [0.0, 0.0, 3.0],
+        direction: [0.0, 0.0, -1.0],
+    };
+    let cases = [
+        (
+            Ray {
+                origin: [f64::NAN, 0.0, 0.0],
+                ..good
+            },
+            "origin",
+        ),
+        (
+            Ray {
+                direction: [0.0; 3],
+                ..good
+            },
+            "zero",
+        ),
+        (
+            Ray {
+                direction: [0.0, f64::INFINITY, 1.0],
+                ..good
+            },
+            "direction coordinates",
+        ),
+    ];
+    for (bad, needle) in cases {
+        let error = cast_rays(&file, &pose, &[good, good, bad], &RayOptions::default())
+            .expect_err("refused");
+        assert!(
+            matches!(
+                error,
+                QueryError::BadInput {
+                    what: "ray",
+                    index: 2,
+                    ..
+                }
+            ),
+            "{error}"
+        );
+        assert!(
+            error.to_string().starts_with("ray 2: ") && error.to_string().contains(needle),
+            "{error}"
+        );
+        assert!(all_ray_hits(&file, &pose, &[bad], 1.0).is_err());
+    }
+    for t_max in [0.0, -1.0, f64::NAN] {
+        let options = RayOptions {
+            t_max,
+            ..Default::default()
+        };
+        let error = cast_rays(&file, &pose, &[good], &options).expect_err("refused");
+        assert!(
+            matches!(error, QueryError::BadOption { name: "t_max", .. }),
+            "{error}"
+        );
+    }
+}
+
+/// Coordinates near the top of f64's range neither panic nor produce NaN: a hit is finite or
+/// there is none.
+#[test]
+fn huge_coordinates_answer_without_nan() {
+    let file: ObbtFile = build(&common::cube(0.5), &Default::default(), None).expect("builds");
+    let rays = [
+        Ray {
+            origin: [1e300, 0.1, 0.2],
+            direction: [-1.0, 0.0, 0.0],
+        },
+        Ray {
+            origin: [0.1, 0.2, 3.0],
+            direction: [1e-300, 0.0, -1e-300],
+        },
+        Ray {
+            origin: [0.1, 0.2, 3.0],
+            direction: [0.0, 1e299, -1e300],
+        },
+        Ray {
+            origin: [-1e308, 1e308, 1e308],
+            direction: [1e308, -1e308, -1e308],
+        },
+    ];
+    for pose in [Pose::identity(), common::turned_pose(3, 1e200)] {
+        for result in cast_rays(&file, &pose, &rays, &RayOptions::default()).expect("answers") {
+            if let Some(hit) = result.hit {
+                assert!(
+                    hit.t.is_finite() && hit.normal.iter().all(|x| x.is_finite()),
+                    "{hit:?}"
+                );
+            }
+        }
+    }
+    // A direction 1e300 long meets the cube 1e-300 along it.
+    let long = cast_rays(
+        &file,
+        &Pose::identity(),
+        &rays[2..3],
+        &RayOptions::default(),
+    )
+    .expect("answers");
+    assert!(long[0].hit.is_some_and(|h| h.t > 0.0 && h.t < 1e-299));
+}
