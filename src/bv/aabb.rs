@@ -149,11 +149,13 @@ impl<R: Real> BoundingVolume for Aabb<R> {
     fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
         let (mut near, mut far) = (0.0f64, t_max);
-        for k in 0..3 {
-            let (o, q) = (origin[k], direction[k]);
+        for ((o, q), (lo, hi)) in arr3::zip(origin, direction)
+            .into_iter()
+            .zip(arr3::zip(lo, hi))
+        {
             // A few ulps of slack on each face, as for the point bound.
-            let slack = 4.0 * f64::EPSILON * (o.abs() + lo[k].abs() + hi[k].abs());
-            let (lo, hi) = (lo[k] - slack, hi[k] + slack);
+            let slack = 4.0 * f64::EPSILON * (o.abs() + lo.abs() + hi.abs());
+            let (lo, hi) = (lo - slack, hi + slack);
             if q == 0.0 {
                 if o < lo || o > hi {
                     return None;

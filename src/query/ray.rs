@@ -25,7 +25,8 @@ pub struct Ray {
 impl Ray {
     /// The ray's point at parameter `t`.
     pub fn at(&self, t: f64) -> [f64; 3] {
-        std::array::from_fn(|k| self.origin[k] + t * self.direction[k])
+        let [(o0, d0), (o1, d1), (o2, d2)] = crate::arr3::zip(self.origin, self.direction);
+        [o0 + t * d0, o1 + t * d1, o2 + t * d2]
     }
 }
 
@@ -390,7 +391,9 @@ fn descend<B: BoundingVolume, C: Collect>(
                         None => work.bv_disjoint += 1,
                     }
                 }
-                stack[start..].sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+                if let Some(pushed) = stack.get_mut(start..) {
+                    pushed.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+                }
             }
         }
     }

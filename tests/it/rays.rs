@@ -11,7 +11,6 @@ use nalgebra::Vector3;
 use obbtree::build::build;
 use obbtree::format::ObbtFile;
 use obbtree::generate::Rng;
-use obbtree::mesh::TriMesh;
 use obbtree::query::triangle::RaySpace;
 use obbtree::query::{all_ray_hits, cast_rays, Pose, QueryError, Ray, RayHit, RayMode, RayOptions};
 

@@ -60,6 +60,8 @@ impl RaySpace {
     /// A corner in the ray's sheared frame: the ray is the +z axis, and `z` is the ray
     /// parameter of the corner's projection onto it.
     #[inline(always)]
+    // why: the axes are a permutation of 0..3, made in `new`.
+    #[allow(clippy::indexing_slicing)]
     fn sheared(&self, p: &Vector3<f64>) -> [f64; 3] {
         let [kx, ky, kz] = self.axes;
         let d = p - self.origin;
