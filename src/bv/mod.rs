@@ -554,23 +554,41 @@ pub(crate) fn box_ray_entry(
 ) -> Option<f64> {
     let half_sum = half[0] + half[1] + half[2];
     let slack = frame_error * half_sum + 16.0 * f64::EPSILON * (l1(&d) + half_sum);
-    let (mut near, mut far) = (0.0f64, t_max);
-    for (axis, h) in axes.iter().zip(half) {
-        let (p, q) = (arr3::dot(*axis, d), arr3::dot(*axis, direction));
+    // Straight-line code with plain comparisons: a ray test is a few dozen flops, and
+    // `f64::max`'s NaN handling or a loop's bookkeeping would cost as much again. A slab
+    // the ray runs parallel to gives infinite crossings (a miss when outside it) or NaN
+    // on its boundary, which the comparisons skip.
+    let slab = |axis: [f64; 3], h: f64| {
+        let (p, inverse) = (arr3::dot(axis, d), 1.0 / arr3::dot(axis, direction));
         let h = h + slack;
-        if q == 0.0 {
-            if p.abs() > h {
-                return None;
-            }
-            continue;
+        let (t0, t1) = ((-h - p) * inverse, (h - p) * inverse);
+        if t0 < t1 {
+            (t0, t1)
+        } else {
+            (t1, t0)
         }
-        let (t0, t1) = ((-h - p) / q, (h - p) / q);
-        let (lo, hi) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-        // (`max` and `min` skip a NaN operand.)
-        near = near.max(lo - 4.0 * f64::EPSILON * lo.abs());
-        far = far.min(hi + 4.0 * f64::EPSILON * hi.abs());
+    };
+    let [(a0, b0), (a1, b1), (a2, b2)] = [
+        slab(axes[0], half[0]),
+        slab(axes[1], half[1]),
+        slab(axes[2], half[2]),
+    ];
+    let (mut near, mut far) = (0.0f64, t_max);
+    for (lo, hi) in [(a0, b0), (a1, b1), (a2, b2)] {
+        if lo > near {
+            near = lo;
+        }
+        if hi < far {
+            far = hi;
+        }
     }
-    (near <= far).then_some(near)
+    // Each crossing's own rounding (x ↦ x ∓ 4ε|x| is monotone, so widening the extremes
+    // widens every crossing).
+    let (near, far) = (
+        near - 4.0 * f64::EPSILON * near.abs(),
+        far + 4.0 * f64::EPSILON * far.abs(),
+    );
+    (near <= far).then_some(near.max(0.0))
 }
 
 /// Sum of absolute coordinates.

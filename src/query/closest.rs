@@ -190,7 +190,9 @@ fn descend<B: BoundingVolume>(
         work: Work::default(),
     };
     let point = [p.x, p.y, p.z];
-    let root = tree.node(0).ok_or(corrupt(Side::A, NodeDefect::Missing))?;
+    let root = tree
+        .node(0)
+        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
     heap.clear();
     let mut dive = Some(Waiting {
         bound: root.bv.point_distance_lower_bound(point),
@@ -227,7 +229,7 @@ fn descend<B: BoundingVolume>(
                 for child in range {
                     let n = tree
                         .node(child)
-                        .ok_or(corrupt(Side::A, NodeDefect::Missing))?;
+                        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
                     let bound = n.bv.point_distance_lower_bound(point);
                     if bound >= found.distance {
                         found.work.nodes_visited += 1;

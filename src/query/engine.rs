@@ -323,8 +323,12 @@ fn descend<B: BoundingVolume, P: Policy<B>, W: Waiting>(
                 what: "a node is reachable along two paths",
             });
         }
-        let na = a.node(ia).ok_or(corrupt(Side::A, NodeDefect::Missing))?;
-        let nb = b.node(ib).ok_or(corrupt(Side::B, NodeDefect::Missing))?;
+        let na = a
+            .node(ia)
+            .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
+        let nb = b
+            .node(ib)
+            .ok_or_else(|| corrupt(Side::B, NodeDefect::Missing))?;
         let key = if P::ORDERED {
             key
         } else {
@@ -415,7 +419,7 @@ impl<B: BoundingVolume> Step<'_, '_, B> {
     fn child(&self, c: u32) -> Result<&Node<B>, QueryError> {
         self.tree
             .node(c)
-            .ok_or(corrupt(self.side, NodeDefect::Missing))
+            .ok_or_else(|| corrupt(self.side, NodeDefect::Missing))
     }
 
     /// The centre of the other node's volume, in A's frame (where B's are mapped).

@@ -343,7 +343,9 @@ fn descend<B: BoundingVolume, C: Collect>(
 ) -> Result<Work, QueryError> {
     let mut work = Work::default();
     stack.clear();
-    let root = tree.node(0).ok_or(corrupt(Side::A, NodeDefect::Missing))?;
+    let root = tree
+        .node(0)
+        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
     work.nodes_visited += 1;
     match root.bv.ray_entry(ray.origin, ray.direction, t_max) {
         Some(entry) => stack.push((entry, 0)),
@@ -384,7 +386,7 @@ fn descend<B: BoundingVolume, C: Collect>(
                 for child in range {
                     let n = tree
                         .node(child)
-                        .ok_or(corrupt(Side::A, NodeDefect::Missing))?;
+                        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
                     work.nodes_visited += 1;
                     match n.bv.ray_entry(ray.origin, ray.direction, reach.min(t_max)) {
                         Some(entry) => stack.push((entry, child)),
