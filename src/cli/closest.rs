@@ -1,14 +1,14 @@
 //! `obbtree closest`: the closest point of one posed model to query points.
 
 use super::build::TreeArgs;
-use super::poses::{parse_numbers, ModelPoseArgs};
+use super::poses::ModelPoseArgs;
 use super::print::out;
-use super::query::{is_tree_input, open_input};
-use super::{number, Failure, WithContext};
+use super::query::open_model;
+use super::rows::numeric_rows;
+use super::{number, Failure};
 use clap::Args;
 use obbtree::query::{closest_points, ClosestOptions, ClosestResult};
 use serde_json::json;
-use std::io::Read;
 use std::path::PathBuf;
 
 /// Find the closest point of a posed model's surface to each query point.
@@ -56,71 +56,16 @@ pub struct ClosestArgs {
     pub tree: TreeArgs,
 }
 
-/// The query points of `--point` or `--points`.
-fn query_points(args: &ClosestArgs) -> Result<Vec<[f64; 3]>, Failure> {
-    let triple = |numbers: Vec<f64>, at: &dyn Fn() -> String| -> Result<[f64; 3], Failure> {
-        <[f64; 3]>::try_from(numbers.as_slice()).map_err(|_| {
-            Failure::msg(format!(
-                "{}: {} numbers, not the 3 of x y z",
-                at(),
-                numbers.len()
-            ))
-        })
-    };
-    match (&args.point, &args.points) {
-        (Some(text), None) => Ok(vec![triple(parse_numbers(text, "--point")?, &|| {
-            "--point".into()
-        })?]),
-        (None, Some(path)) => {
-            let shown = if path.as_os_str() == "-" {
-                "<stdin>".to_string()
-            } else {
-                path.display().to_string()
-            };
-            let mut text = String::new();
-            if path.as_os_str() == "-" {
-                std::io::stdin()
-                    .read_to_string(&mut text)
-                    .with_context(|| format!("{shown}: cannot read"))?;
-            } else {
-                text = std::fs::read_to_string(path)
-                    .with_context(|| format!("{shown}: cannot read"))?;
-            }
-            let mut points = Vec::new();
-            for (line, content) in text.lines().enumerate() {
-                let content = content.trim();
-                if content.is_empty() || content.starts_with('#') {
-                    continue;
-                }
-                let at = || format!("{shown}: line {}", line + 1);
-                points.push(triple(parse_numbers(content, &at())?, &at)?);
-            }
-            if points.is_empty() {
-                return Err(Failure::msg(format!("{shown}: no points")));
-            }
-            Ok(points)
-        }
-        _ => Err(Failure::msg(
-            "give the query points: --point X,Y,Z, or --points FILE (- for stdin)",
-        )),
-    }
-}
-
 pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
     let pose = args.pose.pose()?;
-    let points = query_points(args)?;
-    if is_tree_input(&args.model) {
-        if let Some(flag) = args.tree.given().first() {
-            return Err(Failure::msg(format!(
-                "{flag} applies to mesh models only, and {} is a .obbt file",
-                args.model.display()
-            )));
-        }
-    }
-    // Bad option values are reported before a (possibly large) mesh is read.
-    let tree_options = args.tree.options();
-    tree_options.validate()?;
-    let model = open_input(&args.model, &tree_options)?;
+    let points = numeric_rows::<3>(
+        args.point.as_deref(),
+        "--point X,Y,Z",
+        args.points.as_deref(),
+        "--points",
+        "x y z",
+    )?;
+    let model = open_model(&args.model, &args.tree)?;
     let options = ClosestOptions {
         max_distance: args.max_distance.unwrap_or(f64::INFINITY),
     };

@@ -13,6 +13,8 @@ mod poses;
 mod print;
 mod progress;
 mod query;
+mod ray;
+mod rows;
 mod scene;
 mod verify;
 
@@ -48,6 +50,7 @@ enum Command {
     Distance(query::DistanceArgs),
     Span(query::SpanArgs),
     Closest(closest::ClosestArgs),
+    Ray(ray::RayArgs),
     Scene(scene::SceneArgs),
     Demo(demo::DemoArgs),
     Experiment(experiment::ExperimentArgs),
@@ -142,6 +145,7 @@ pub fn main() -> ExitCode {
         Command::Distance(args) => query::distance(&args),
         Command::Span(args) => query::span(&args),
         Command::Closest(args) => closest::run(&args),
+        Command::Ray(args) => ray::run(&args),
         Command::Scene(args) => scene::run(&args).map(|_| ()),
         Command::Demo(args) => demo::run(&args),
         Command::Experiment(args) => experiment::run(&args),

@@ -176,6 +176,22 @@ pub(super) fn open_input(path: &Path, options: &BuildOptions) -> Result<ObbtFile
     build_with_progress(&mesh, options, &path.display().to_string(), false)
 }
 
+/// The one model of a single-model query (`closest`, `ray`): a .obbt file, refusing mesh
+/// build flags, or a mesh built with them (checked before the mesh is read).
+pub(super) fn open_model(path: &Path, tree: &TreeArgs) -> Result<ObbtFile, Failure> {
+    if is_tree_input(path) {
+        if let Some(flag) = tree.given().first() {
+            return Err(Failure::msg(format!(
+                "{flag} applies to mesh models only, and {} is a .obbt file",
+                path.display()
+            )));
+        }
+    }
+    let options = tree.options();
+    options.validate()?;
+    open_input(path, &options)
+}
+
 fn open_pair(inputs: &QueryInputs) -> Result<(ObbtFile, ObbtFile), Failure> {
     let tree = &inputs.tree;
     let mut options = tree.options();

@@ -65,8 +65,8 @@ impl ClosestResult {
 ///
 /// # Errors
 ///
-/// - [`QueryError::BadOption`] for a non-finite query point or a `max_distance` that is not
-///   greater than 0.
+/// - [`QueryError::BadInput`] for a query point with a non-finite coordinate,
+///   [`QueryError::BadOption`] for a `max_distance` that is not greater than 0.
 /// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
 ///
 /// # Examples
@@ -98,12 +98,15 @@ pub fn closest_points(
             value: options.max_distance,
         });
     }
-    if let Some(bad) = points.iter().flatten().find(|x| !x.is_finite()) {
-        return Err(QueryError::BadOption {
-            name: "query point coordinate",
-            requirement: "finite",
-            value: *bad,
-        });
+    for (index, p) in points.iter().enumerate() {
+        if let Some(bad) = p.iter().find(|x| !x.is_finite()) {
+            return Err(QueryError::BadInput {
+                what: "query point",
+                index,
+                requirement: "coordinates must be finite",
+                value: *bad,
+            });
+        }
     }
     /// The typed descent, run for every point.
     struct Visit<'q> {

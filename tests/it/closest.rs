@@ -174,24 +174,34 @@ fn features_name_where_the_point_lies() {
 fn bad_query_points_and_limits_are_refused() {
     let file = build(&common::cube(0.5), &Default::default(), None).expect("builds");
     let pose = Pose::identity();
-    for (points, max_distance, name) in [
-        (
-            vec![[0.0, f64::NAN, 0.0]],
-            f64::INFINITY,
-            "query point coordinate",
-        ),
-        (
-            vec![[f64::INFINITY, 0.0, 0.0]],
-            f64::INFINITY,
-            "query point coordinate",
-        ),
-        (vec![[0.0; 3]], 0.0, "max_distance"),
-        (vec![[0.0; 3]], f64::NAN, "max_distance"),
-    ] {
-        let error = closest_points(&file, &pose, &points, &ClosestOptions { max_distance })
-            .expect_err("refused");
+    for bad in [[0.0, f64::NAN, 0.0], [f64::INFINITY, 0.0, 0.0]] {
+        let points = [[0.0; 3], bad];
+        let error =
+            closest_points(&file, &pose, &points, &Default::default()).expect_err("refused");
         assert!(
-            matches!(error, QueryError::BadOption { name: n, .. } if n == name),
+            matches!(
+                error,
+                QueryError::BadInput {
+                    what: "query point",
+                    index: 1,
+                    ..
+                }
+            ),
+            "{error}"
+        );
+        assert!(error.to_string().starts_with("query point 1: "), "{error}");
+    }
+    for max_distance in [0.0, f64::NAN] {
+        let options = ClosestOptions { max_distance };
+        let error = closest_points(&file, &pose, &[[0.0; 3]], &options).expect_err("refused");
+        assert!(
+            matches!(
+                error,
+                QueryError::BadOption {
+                    name: "max_distance",
+                    ..
+                }
+            ),
             "{error}"
         );
     }

@@ -391,3 +391,96 @@ fn huge_coordinates_answer_without_nan() {
     .expect("answers");
     assert!(long[0].hit.is_some_and(|h| h.t > 0.0 && h.t < 1e-299));
 }
+
+/// `obbtree ray` prints what the library answers, ray by ray and mode by mode, and
+/// refuses bad input with one line and status 1.
+#[test]
+fn the_cli_answers_as_the_library() {
+    use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
+    let dir = scratch("rays");
+    let path = dir.join("rays.txt");
+    std::fs::write(
+        &path,
+        "# ox oy oz dx dy dz\n-10 0.01 0.02 1 0 0\n\n0,5,0,0,-1,0\n0 5 0 0 1 0\n",
+    )
+    .expect("writes");
+    let pose = "1,0,0,0,0,-1,0,1,0,0.1,0,0";
+    let rays = [
+        Ray {
+            origin: [-10.0, 0.01, 0.02],
+            direction: [1.0, 0.0, 0.0],
+        },
+        Ray {
+            origin: [0.0, 5.0, 0.0],
+            direction: [0.0, -1.0, 0.0],
+        },
+        Ray {
+            origin: [0.0, 5.0, 0.0],
+            direction: [0.0, 1.0, 0.0],
+        },
+    ];
+    let file = build(&common::cow(), &Default::default(), None).expect("builds");
+    let pose_value =
+        Pose::from_row_major(&[1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.1, 0.0, 0.0])
+            .expect("a pose");
+    // serde_json's parser may be an ulp off the printed shortest decimal.
+    let same = |a: f64, b: f64| (a - b).abs() <= 4.0 * f64::EPSILON * b.abs();
+    let run = |mode: &str| -> Vec<serde_json::Value> {
+        let o = obbtree(&[
+            "ray",
+            cow().as_str(),
+            "--rays",
+            path.to_str().expect("a path"),
+            "--pose",
+            pose,
+            "--mode",
+            mode,
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(|l| serde_json::from_str(l).expect("JSON"))
+            .collect()
+    };
+    let closest = cast_rays(&file, &pose_value, &rays, &RayOptions::default()).expect("answers");
+    let lines = run("closest");
+    assert_eq!(lines.len(), 3);
+    for (i, (line, answer)) in lines.iter().zip(&closest).enumerate() {
+        assert_eq!(line["ray"], i);
+        assert_eq!(line["hit"], answer.hit.is_some());
+        if let Some(h) = answer.hit {
+            assert!(same(line["t"].as_f64().expect("t"), h.t), "{line}");
+            assert_eq!(line["triangle"], h.triangle);
+        }
+    }
+    assert!(closest[0].hit.is_some() && closest[2].hit.is_none());
+    let all = all_ray_hits(&file, &pose_value, &rays, f64::INFINITY).expect("answers");
+    for (line, answer) in run("all").iter().zip(&all) {
+        let ts: Vec<f64> = line["hits"]
+            .as_array()
+            .expect("hits")
+            .iter()
+            .map(|h| h["t"].as_f64().expect("t"))
+            .collect();
+        assert_eq!(ts.len(), answer.hits.len());
+        assert!(ts.iter().zip(&answer.hits).all(|(t, h)| same(*t, h.t)), "{line}");
+    }
+    assert!(all[0].hits.len() >= 2);
+    assert_eq!(run("any")[2]["hit"], false);
+    let cow_path = cow();
+    for (args, needle) in [
+        (vec!["--ray", "1,2,3"], "--ray"),
+        (
+            vec!["--ray", "0,0,0,0,0,0"],
+            "ray 0: direction must not be zero",
+        ),
+        (vec!["--ray", "0,0,nan,1,0,0"], "finite"),
+        (vec!["--ray", "0,0,0,1,0,0", "--t-max", "0"], "t_max"),
+        (vec![], "--rays"),
+    ] {
+        let mut every = vec!["ray", cow_path.as_str()];
+        every.extend(args);
+        assert_bad_input(&obbtree(&every), needle);
+    }
+}

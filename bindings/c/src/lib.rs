@@ -336,7 +336,9 @@ impl From<QueryError> for Error {
     fn from(e: QueryError) -> Error {
         let status = match e {
             QueryError::MismatchedTrees { .. } => ObbtreeStatus::MismatchedTrees,
-            QueryError::BadOption { .. } => ObbtreeStatus::BadArgument,
+            QueryError::BadOption { .. } | QueryError::BadInput { .. } => {
+                ObbtreeStatus::BadArgument
+            }
             QueryError::Format(_) => ObbtreeStatus::Format,
             _ => ObbtreeStatus::CorruptTree,
         };

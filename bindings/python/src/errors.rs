@@ -65,7 +65,7 @@ impl From<QueryError> for Failure {
         let kind = match e {
             QueryError::MismatchedTrees { .. } => Kind::Base,
             QueryError::CorruptTree { .. } | QueryError::Format(_) => Kind::Format,
-            QueryError::BadOption { .. } => Kind::Option,
+            QueryError::BadOption { .. } | QueryError::BadInput { .. } => Kind::Option,
             _ => Kind::Base,
         };
         Failure::new(kind, e.to_string())

@@ -1,0 +1,66 @@
+//! Query inputs given as rows of numbers: one on the command line, or a file or stdin of
+//! lines (what `closest` and `ray` read).
+
+use super::poses::parse_numbers;
+use super::{Failure, WithContext};
+use std::io::Read;
+use std::path::Path;
+
+/// The rows of `N` numbers (named `names`, e.g. `x y z`) given by exactly one of
+/// `single` (the text of flag `single_flag`) and `file` (a path, `-` for stdin, of lines
+/// of `N` numbers separated by spaces or commas; blank lines and `#` comments skipped).
+pub fn numeric_rows<const N: usize>(
+    single: Option<&str>,
+    single_flag: &str,
+    file: Option<&Path>,
+    file_flag: &str,
+    names: &str,
+) -> Result<Vec<[f64; N]>, Failure> {
+    let row = |numbers: Vec<f64>, at: &dyn Fn() -> String| -> Result<[f64; N], Failure> {
+        <[f64; N]>::try_from(numbers.as_slice()).map_err(|_| {
+            Failure::msg(format!(
+                "{}: {} numbers, not the {N} of {names}",
+                at(),
+                numbers.len()
+            ))
+        })
+    };
+    match (single, file) {
+        (Some(text), None) => Ok(vec![row(parse_numbers(text, single_flag)?, &|| {
+            single_flag.into()
+        })?]),
+        (None, Some(path)) => {
+            let stdin = path.as_os_str() == "-";
+            let shown = if stdin {
+                "<stdin>".to_string()
+            } else {
+                path.display().to_string()
+            };
+            let mut text = String::new();
+            if stdin {
+                std::io::stdin()
+                    .read_to_string(&mut text)
+                    .with_context(|| format!("{shown}: cannot read"))?;
+            } else {
+                text = std::fs::read_to_string(path)
+                    .with_context(|| format!("{shown}: cannot read"))?;
+            }
+            let mut rows = Vec::new();
+            for (line, content) in text.lines().enumerate() {
+                let content = content.trim();
+                if content.is_empty() || content.starts_with('#') {
+                    continue;
+                }
+                let at = || format!("{shown}: line {}", line + 1);
+                rows.push(row(parse_numbers(content, &at())?, &at)?);
+            }
+            if rows.is_empty() {
+                return Err(Failure::msg(format!("{shown}: no rows of {names}")));
+            }
+            Ok(rows)
+        }
+        _ => Err(Failure::msg(format!(
+            "give {single_flag} or {file_flag} FILE (- for stdin)"
+        ))),
+    }
+}
