@@ -464,7 +464,10 @@ fn the_cli_answers_as_the_library() {
             .map(|h| h["t"].as_f64().expect("t"))
             .collect();
         assert_eq!(ts.len(), answer.hits.len());
-        assert!(ts.iter().zip(&answer.hits).all(|(t, h)| same(*t, h.t)), "{line}");
+        assert!(
+            ts.iter().zip(&answer.hits).all(|(t, h)| same(*t, h.t)),
+            "{line}"
+        );
     }
     assert!(all[0].hits.len() >= 2);
     assert_eq!(run("any")[2]["hit"], false);

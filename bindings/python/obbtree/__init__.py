@@ -20,7 +20,7 @@ A pose is a (4, 4) rigid matrix, 12 numbers (rotation row-major, then translatio
 ``(R, t)`` pair; a batch is (N, 4, 4) or (N, 12). A world point is ``R @ p + t``.
 
 Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``, and
-``closest`` (one model against many points); classes ``Tree``, ``Scene`` and the result
+``closest`` and ``ray`` (one model against many points or rays); classes ``Tree``, ``Scene`` and the result
 classes; exceptions ``Error`` and its subclasses
 ``MeshError``, ``FormatError``, ``PoseError``, ``SceneError``, ``OptionError``,
 ``FileError``.
@@ -51,6 +51,7 @@ from ._obbtree import (
     __version__,
     _build,
     _closest,
+    _ray,
     collide,
     distance,
     open,
@@ -67,6 +68,9 @@ __all__ = [
     "span",
     "closest",
     "ClosestResult",
+    "ray",
+    "RayResult",
+    "RayHits",
     "Tree",
     "Scene",
     "CollideResult",
@@ -227,3 +231,104 @@ def closest(
     for a in arrays:
         a.flags.writeable = False
     return ClosestResult(*arrays)
+
+
+@dataclasses.dataclass(frozen=True)
+class RayResult:
+    """The answers of ``ray`` in ``"closest"`` or ``"any"`` mode for N rays (read-only
+    arrays).
+
+    ``hit`` (N,) bool; ``t`` (N,) float64: the ray parameter of the hit, ``origin + t *
+    direction`` (the distance for unit directions), +inf on a miss; ``tri`` (N,) int64: the
+    input-mesh triangle hit (-1); ``point`` (N, 3) float64: the hit point, world frame
+    (NaN); ``barycentric`` (N, 3) float64: its weights on the triangle's corners, in input
+    order (NaN); ``normal`` (N, 3) float64: the triangle's unit normal, world frame, from its
+    corners' order whichever side the ray came from (NaN).
+    """
+
+    hit: np.ndarray
+    t: np.ndarray
+    tri: np.ndarray
+    point: np.ndarray
+    barycentric: np.ndarray
+    normal: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True)
+class RayHits:
+    """The answers of ``ray`` in ``"all"`` mode: the M hits of N rays, ray by ray and by
+    increasing ``t`` within a ray (read-only arrays).
+
+    ``count`` (N,) int64: hits per ray (even for a ray from outside a closed model);
+    ``ray`` (M,) int64: the ray of each hit; ``t``, ``tri``, ``point``, ``barycentric``,
+    ``normal``: as in ``RayResult``, one row per hit. The hits of ray ``i`` are rows
+    ``offsets[i]:offsets[i + 1]`` with ``offsets = np.concatenate([[0], np.cumsum(count)])``.
+    """
+
+    count: np.ndarray
+    ray: np.ndarray
+    t: np.ndarray
+    tri: np.ndarray
+    point: np.ndarray
+    barycentric: np.ndarray
+    normal: np.ndarray
+
+
+def ray(
+    tree: Tree,
+    pose: Any,
+    origins: Any,
+    directions: Any,
+    t_max: float = np.inf,
+    mode: str = "closest",
+    *,
+    orthonormalize: bool = False,
+) -> Union[RayResult, RayHits]:
+    """Where rays meet a posed model: the closest hit, any hit, or all hits of each.
+
+    ``pose`` is one pose of ``tree``; ``origins`` and ``directions`` are (N, 3) arrays of
+    world points and vectors, or one (3,) row shared by every ray (a camera's origin). A
+    ray's points are ``origin + t * direction`` for ``0 <= t <= t_max``. ``mode`` is
+    ``"closest"`` (the hit of smallest t), ``"any"`` (one hit, the first found: line of
+    sight) or ``"all"``. Rays are cast in parallel with the GIL released. Hits are
+    watertight: a ray through an edge or corner shared by triangles hits one of them.
+    Returns a ``RayResult`` (closest, any) or a ``RayHits`` (all).
+
+    Raises ``OptionError`` (a ValueError) for arrays of other shapes, a non-finite origin,
+    a zero or non-finite direction (naming the ray), a ``t_max`` not above 0 or an unknown
+    mode; ``PoseError`` for a pose that is not a rigid motion.
+    """
+    o = np.asarray(origins, dtype=np.float64)
+    d = np.asarray(directions, dtype=np.float64)
+    for name, a in (("origins", o), ("directions", d)):
+        if not (a.shape == (3,) or (a.ndim == 2 and a.shape[1] == 3)):
+            raise OptionError(f"{name} must be an (N, 3) array or one row (3,), got shape {a.shape}")
+    n = max(len(a) if a.ndim == 2 else 1 for a in (o, d))
+    o, d = (np.broadcast_to(a, (n, 3)) if a.ndim == 1 else a for a in (o, d))
+    if len(o) != len(d):
+        raise OptionError(f"origins and directions differ in length: {len(o)} and {len(d)}")
+    index, t, tri, bary, normal = _ray(
+        tree, pose, np.ascontiguousarray(o), np.ascontiguousarray(d), float(t_max), mode,
+        orthonormalize,
+    )
+    point = o[index] + t[:, None] * d[index]
+    if mode == "all":
+        count = np.bincount(index, minlength=n).astype(np.int64)
+        result: Union[RayResult, RayHits] = RayHits(count, index, t, tri, point, bary, normal)
+    else:
+        hit = np.zeros(n, dtype=bool)
+        hit[index] = True
+        full_t = np.full(n, np.inf)
+        full_t[index] = t
+        full_tri = np.full(n, -1, dtype=np.int64)
+        full_tri[index] = tri
+        rows = []
+        for values in (point, bary, normal):
+            full = np.full((n, 3), np.nan)
+            full[index] = values
+            rows.append(full)
+        result = RayResult(hit, full_t, full_tri, *rows)
+    # (Not dataclasses.astuple: it copies the arrays.)
+    for field in dataclasses.fields(result):
+        getattr(result, field.name).flags.writeable = False
+    return result

@@ -234,6 +234,21 @@ def _closest(
     npt.NDArray[np.int8],
     npt.NDArray[np.int8],
 ]: ...
+def _ray(
+    tree: Tree,
+    pose: Poses,
+    origins: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64],
+    t_max: float,
+    mode: str,
+    orthonormalize: bool,
+) -> Tuple[
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+]: ...
 def _time_rust_loop(
     a: Tree, poses_a: Poses, b: Tree, poses_b: Poses, query: str, repeat: int
 ) -> float: ...

@@ -10,6 +10,7 @@ mod errors;
 mod json;
 mod poses;
 mod queries;
+mod ray;
 mod scene;
 mod tree;
 
@@ -138,6 +139,7 @@ fn _obbtree(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::within, m)?)?;
     m.add_function(wrap_pyfunction!(queries::span, m)?)?;
     m.add_function(wrap_pyfunction!(closest::_closest, m)?)?;
+    m.add_function(wrap_pyfunction!(ray::_ray, m)?)?;
     m.add_function(wrap_pyfunction!(queries::_time_rust_loop, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
