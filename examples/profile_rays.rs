@@ -4,7 +4,8 @@
 //! bounding sphere, coherent) and random rays (from random points of a sphere twice the
 //! bounding sphere to random points of the bounding box, incoherent). Prints the median
 //! time per closest-hit ray, the hit fraction and the mean work; trees are f64 unless
-//! `OBBTREE_PRECISION=f32`, in the fast layout unless `OBBTREE_LAYOUT=compact` (f32).
+//! `OBBTREE_PRECISION=f32`, in the fast layout unless `OBBTREE_LAYOUT=compact` (f32), of
+//! oriented boxes unless `OBBTREE_BV=aabb` or `sphere`.
 // A tool developers run by hand: stopping loudly on a broken input is what it should do.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
@@ -28,7 +29,13 @@ fn main() {
         Ok("compact") => obbtree::bv::Layout::Compact,
         _ => obbtree::bv::Layout::Fast,
     };
+    let bv = match std::env::var("OBBTREE_BV").as_deref() {
+        Ok("aabb") => obbtree::bv::BvKind::Aabb,
+        Ok("sphere") => obbtree::bv::BvKind::Sphere,
+        _ => obbtree::bv::BvKind::Obb,
+    };
     let options = BuildOptions {
+        bv,
         precision,
         layout,
         leaf_size: layout.default_leaf_size(),
