@@ -1,18 +1,19 @@
 //! Casts rays at one mesh, for profilers (perf, callgrind):
 //! `cargo run --release --example profile_rays -- MESH [RAYS] [RUNS]` (threads:
-//! `RAYON_NUM_THREADS`). Two sets: camera rays (a square image seen from outside the
-//! bounding sphere, coherent) and random rays (from random points of a sphere twice the
-//! bounding sphere to random points of the bounding box, incoherent). Prints the median
+//! `RAYON_NUM_THREADS`). Two sets (`benches/support/rays.rs`): camera rays (coherent) and
+//! random rays (incoherent). Prints the median
 //! time per closest-hit ray, the hit fraction and the mean work; trees are f64 unless
 //! `OBBTREE_PRECISION=f32`, in the fast layout unless `OBBTREE_LAYOUT=compact` (f32), of
 //! oriented boxes unless `OBBTREE_BV=aabb` or `sphere`.
 // A tool developers run by hand: stopping loudly on a broken input is what it should do.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
+#[path = "../benches/support/rays.rs"]
+mod rays;
+
 use obbtree::build::{build, BuildOptions};
-use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
-use obbtree::query::{cast_rays, Pose, Ray, RayOptions};
+use obbtree::query::{cast_rays, Pose, RayOptions};
 use std::time::Instant;
 
 fn main() {
@@ -42,52 +43,8 @@ fn main() {
         ..BuildOptions::default()
     };
     let file = build(&mesh, &options, None).expect("builds");
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for v in mesh.vertices() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(v[k]);
-            hi[k] = hi[k].max(v[k]);
-        }
-    }
-    let centre: [f64; 3] = std::array::from_fn(|k| (lo[k] + hi[k]) / 2.0);
-    let radius = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt() / 2.0;
-    let mut rng = Rng::new(7);
-    let side = (count as f64).sqrt().ceil() as usize;
-    let camera: Vec<Ray> = (0..side * side)
-        .map(|i| {
-            let (u, v) = (
-                (i % side) as f64 / side as f64,
-                (i / side) as f64 / side as f64,
-            );
-            let origin = [centre[0], centre[1], centre[2] + 3.0 * radius];
-            let target = [
-                centre[0] + (2.0 * u - 1.0) * radius,
-                centre[1] + (2.0 * v - 1.0) * radius,
-                centre[2],
-            ];
-            Ray {
-                origin,
-                direction: std::array::from_fn(|k| target[k] - origin[k]),
-            }
-        })
-        .collect();
-    let random: Vec<Ray> = (0..count)
-        .map(|_| {
-            let d = loop {
-                let d = [rng.signed(), rng.signed(), rng.signed()];
-                let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if n > 0.1 && n <= 1.0 {
-                    break d.map(|x| x / n);
-                }
-            };
-            let origin: [f64; 3] = std::array::from_fn(|k| centre[k] + 2.0 * radius * d[k]);
-            let target: [f64; 3] = std::array::from_fn(|k| lo[k] + (hi[k] - lo[k]) * rng.unit());
-            Ray {
-                origin,
-                direction: std::array::from_fn(|k| target[k] - origin[k]),
-            }
-        })
-        .collect();
+    let camera = rays::camera_rays(&mesh, count);
+    let random = rays::random_rays(&mesh, count, 7);
     for (name, rays) in [("camera", &camera), ("random", &random)] {
         let mut times = Vec::new();
         let mut last = Vec::new();

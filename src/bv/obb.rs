@@ -395,7 +395,7 @@ impl<R: Real> BoundingVolume for Obb<R> {
         super::box_point_distance_bound(d, &self.axes_f64(), self.half_f64(), tol)
     }
 
-    #[inline]
+    #[inline(always)]
     fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
         let d = arr3::sub(origin, self.center_f64());
         let tol = axis_tolerance(R::PRECISION);
