@@ -220,7 +220,7 @@ pub(super) fn triangle<B: BoundingVolume>(
     b_to_a: Option<&Pose>,
     which: Side,
 ) -> Result<Triangle, QueryError> {
-    let t = tree.triangle(face).ok_or_else(|| QueryError::CorruptTree {
+    let t = tree.triangle(face).ok_or(QueryError::CorruptTree {
         which,
         what: "face or vertex index out of bounds",
     })?;

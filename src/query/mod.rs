@@ -123,7 +123,7 @@ pub(crate) fn source_id<B: crate::bv::BoundingVolume>(
     face: u32,
     which: Side,
 ) -> Result<u32, QueryError> {
-    tree.source_id(face).ok_or_else(|| QueryError::CorruptTree {
+    tree.source_id(face).ok_or(QueryError::CorruptTree {
         which,
         what: "face index out of bounds",
     })
