@@ -11,7 +11,6 @@
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 #[path = "support/parry.rs"]
 #[allow(dead_code)]
