@@ -3,7 +3,7 @@
 
 use super::engine::{corrupt, triangle};
 use super::triangle::{closest_point_on_triangle, Feature};
-use super::{source_id, QueryError, Side, Work};
+use super::{check_points, source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
@@ -98,16 +98,7 @@ pub fn closest_points(
             value: options.max_distance,
         });
     }
-    for (index, p) in points.iter().enumerate() {
-        if let Some(bad) = p.iter().find(|x| !x.is_finite()) {
-            return Err(QueryError::BadInput {
-                what: "query point",
-                index,
-                requirement: "coordinates must be finite",
-                value: *bad,
-            });
-        }
-    }
+    check_points(points)?;
     /// The typed descent, run for every point.
     struct Visit<'q> {
         pose: &'q Pose,

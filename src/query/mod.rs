@@ -36,6 +36,7 @@ mod pair_query;
 mod ray;
 mod span;
 pub mod triangle;
+mod winding;
 mod work;
 
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
@@ -50,6 +51,7 @@ pub use engine::QueryContext;
 pub use pair_query::PairQuery;
 pub use ray::{all_ray_hits, cast_rays, Ray, RayHit, RayHits, RayMode, RayOptions, RayResult};
 pub use span::{SpanOptions, SpanResult};
+pub use winding::{signed_distances, winding_numbers, WindingOptions, WindingResult};
 pub use work::Work;
 
 /// One of the two models of a pair query: A, in whose frame results are given, or B.
@@ -127,4 +129,19 @@ pub(crate) fn source_id<B: crate::bv::BoundingVolume>(
         which,
         what: "face index out of bounds",
     })
+}
+
+/// The error naming the first query point with a non-finite coordinate.
+pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), QueryError> {
+    for (index, p) in points.iter().enumerate() {
+        if let Some(bad) = p.iter().find(|x| !x.is_finite()) {
+            return Err(QueryError::BadInput {
+                what: "query point",
+                index,
+                requirement: "coordinates must be finite",
+                value: *bad,
+            });
+        }
+    }
+    Ok(())
 }

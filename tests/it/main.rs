@@ -36,4 +36,5 @@ mod scene_work;
 mod scenes;
 mod triangle_primitives;
 mod units;
+mod winding;
 mod work_pins;

@@ -1,0 +1,322 @@
+//! Inside or outside: the generalised winding number of one posed model at query points
+//! (Jacobson, Kavan and Sorkine-Hornung 2013), summed exactly triangle by triangle or, for
+//! far clusters of triangles, by their dipole moment (Barill et al. 2018) under a proven
+//! bound on the error.
+//!
+//! The winding number of a closed, outward-facing surface is 1 inside and 0 outside; of a
+//! surface with holes, duplicate or self-intersecting triangles (a soup) it varies smoothly
+//! between, and `> 0.5` is the robust inside test.
+
+use super::closest::{closest_points, ClosestOptions};
+use super::engine::{corrupt, triangle};
+use super::{check_points, QueryError, Side, Work};
+use crate::bv::BoundingVolume;
+use crate::format::{ObbtFile, TreeVisitor};
+use crate::pose::Pose;
+use crate::tree::{NodeDefect, NodeKind, TreeView};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::f64::consts::PI;
+
+/// How winding numbers are asked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindingOptions {
+    /// The largest error allowed in each winding number (`≥ 0`; 0 sums every triangle
+    /// exactly). Far clusters of triangles are summed by their dipole moment while the
+    /// proven bound on the error that adds stays within this.
+    pub tolerance: f64,
+}
+
+impl Default for WindingOptions {
+    fn default() -> Self {
+        WindingOptions { tolerance: 1e-3 }
+    }
+}
+
+/// The winding number at one query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindingResult {
+    /// The generalised winding number: 1 inside a closed outward-facing surface, 0
+    /// outside, between for open surfaces; the point is inside where it is `> 0.5`.
+    pub value: f64,
+    /// A bound on `|value − exact|` from the clusters summed by their dipole moments (0
+    /// when every triangle was summed exactly), at most [`WindingOptions::tolerance`];
+    /// rounding comes on top.
+    pub error_bound: f64,
+    /// Work done: I counts clusters opened, D clusters summed by their moments, S
+    /// triangles summed exactly.
+    pub work: Work,
+}
+
+impl WindingResult {
+    /// Whether the point is inside: the winding number is above one half.
+    pub fn inside(&self) -> bool {
+        self.value > 0.5
+    }
+}
+
+/// The winding number of `model`, posed by `pose` (model frame to world), at each of
+/// `points` (world frame), computed in parallel.
+///
+/// Triangles count with the orientation of their corners' order (counterclockwise seen
+/// from outside is outward). Far clusters of triangles are summed by their area-weighted
+/// normal at their centroid: for a cluster of area `A` within radius `r` of its centroid,
+/// seen from `R > r` away, that errs by at most `A r / (2π (R − r)³)` (the integrand's
+/// gradient is at most `2 / distance³`), and a cluster is summed so only while that bound
+/// is within its share of the tolerance by area.
+///
+/// # Errors
+///
+/// - [`QueryError::BadInput`] for a query point with a non-finite coordinate,
+///   [`QueryError::BadOption`] for a negative or NaN tolerance.
+/// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::format::ObbtFile;
+/// use obbtree::query::{winding_numbers, Pose, WindingOptions};
+///
+/// let cow = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/cow.obbt"))?;
+/// let points = [[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]];
+/// let w = winding_numbers(&cow, &Pose::identity(), &points, &WindingOptions::default())?;
+/// println!("{:.3} (inside: {}), {:.3}", w[0].value, w[0].inside(), w[1].value);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn winding_numbers(
+    model: &ObbtFile,
+    pose: &Pose,
+    points: &[[f64; 3]],
+    options: &WindingOptions,
+) -> Result<Vec<WindingResult>, QueryError> {
+    if options
+        .tolerance
+        .partial_cmp(&0.0)
+        .is_none_or(Ordering::is_lt)
+    {
+        return Err(QueryError::BadOption {
+            name: "tolerance",
+            requirement: "0 or more",
+            value: options.tolerance,
+        });
+    }
+    check_points(points)?;
+    /// The typed descent, run for every point.
+    struct Visit<'q> {
+        pose: &'q Pose,
+        points: &'q [[f64; 3]],
+        tolerance: f64,
+    }
+    impl TreeVisitor for Visit<'_> {
+        type Output = Result<Vec<WindingResult>, QueryError>;
+        fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
+            let moments = moments(&tree)?;
+            let total = moments.first().map_or(0.0, |m| m.area);
+            // Bound per unit area: a cluster of area A may err by A times this.
+            let rate = if total > 0.0 {
+                self.tolerance / total
+            } else {
+                0.0
+            };
+            let to_model = Pose::relative(self.pose, &Pose::identity());
+            self.points
+                .par_iter()
+                .map_init(Vec::new, |stack, p| {
+                    let local = to_model.apply(&Vector3::from(*p));
+                    descend(&tree, &moments, &local, rate, stack)
+                })
+                .collect()
+        }
+    }
+    model.visit(Visit {
+        pose,
+        points,
+        tolerance: options.tolerance,
+    })?
+}
+
+/// The signed distance of `model`, posed by `pose`, at each of `points` (world frame):
+/// the distance to the closest surface point, negative where the winding number (within
+/// `options`' tolerance) says the point is inside. Computed in parallel.
+///
+/// # Errors
+///
+/// As [`winding_numbers`].
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::format::ObbtFile;
+/// use obbtree::query::{signed_distances, Pose, WindingOptions};
+///
+/// let cow = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/cow.obbt"))?;
+/// let d = signed_distances(&cow, &Pose::identity(), &[[0.0; 3]], &WindingOptions::default())?;
+/// println!("{:.4}", d[0]);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn signed_distances(
+    model: &ObbtFile,
+    pose: &Pose,
+    points: &[[f64; 3]],
+    options: &WindingOptions,
+) -> Result<Vec<f64>, QueryError> {
+    let winding = winding_numbers(model, pose, points, options)?;
+    let closest = closest_points(model, pose, points, &ClosestOptions::default())?;
+    Ok(winding
+        .iter()
+        .zip(&closest)
+        .map(|(w, c)| {
+            let d = c.distance();
+            if w.inside() {
+                -d
+            } else {
+                d
+            }
+        })
+        .collect())
+}
+
+/// What a cluster of triangles (a node's) looks like from afar: its area, its area-weighted
+/// normal `Σ A n`, its area-weighted centroid, and the radius about that centroid within
+/// which all its corners lie (model frame).
+#[derive(Clone, Copy, Debug, Default)]
+struct Moment {
+    area: f64,
+    normal: Vector3<f64>,
+    centroid: Vector3<f64>,
+    radius: f64,
+}
+
+/// Every node's moment, children before parents (children follow their parent in the
+/// node array, checked by `node_kind`).
+fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, QueryError> {
+    let mut out = vec![Moment::default(); tree.nodes().len()];
+    for node in (0..tree.nodes().len() as u32).rev() {
+        let m = match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
+            NodeKind::Faces(faces) => {
+                let mut corners = Vec::new();
+                let (mut area, mut normal, mut weighted) =
+                    (0.0, Vector3::zeros(), Vector3::zeros());
+                for face in faces {
+                    let t = triangle(tree, face, None, Side::A)?;
+                    let n = (t[1] - t[0]).cross(&(t[2] - t[0])) / 2.0;
+                    let a = n.norm();
+                    area += a;
+                    normal += n;
+                    weighted += (t[0] + t[1] + t[2]) * (a / 3.0);
+                    corners.extend(t);
+                }
+                let centroid = centre(weighted, area, corners.iter().copied());
+                let radius = corners
+                    .iter()
+                    .map(|c| (c - centroid).norm())
+                    .fold(0.0, f64::max);
+                Moment {
+                    area,
+                    normal,
+                    centroid,
+                    radius,
+                }
+            }
+            NodeKind::Children(range) => {
+                let kids = out
+                    .get(range.start as usize..range.end as usize)
+                    .ok_or_else(|| corrupt(Side::A, NodeDefect::BadChildren))?;
+                let area = kids.iter().map(|k| k.area).sum::<f64>();
+                let normal = kids.iter().map(|k| k.normal).sum();
+                let weighted = kids.iter().map(|k| k.centroid * k.area).sum();
+                let centroid = centre(weighted, area, kids.iter().map(|k| k.centroid));
+                let radius = kids
+                    .iter()
+                    .map(|k| (k.centroid - centroid).norm() + k.radius)
+                    .fold(0.0, f64::max);
+                Moment {
+                    area,
+                    normal,
+                    centroid,
+                    radius,
+                }
+            }
+        };
+        if let Some(slot) = out.get_mut(node as usize) {
+            *slot = m;
+        }
+    }
+    Ok(out)
+}
+
+/// The area-weighted centroid, or for a cluster of no area the mean of `points`.
+fn centre(
+    weighted: Vector3<f64>,
+    area: f64,
+    points: impl Iterator<Item = Vector3<f64>>,
+) -> Vector3<f64> {
+    if area > 0.0 {
+        return weighted / area;
+    }
+    let (sum, n) = points.fold((Vector3::zeros(), 0.0), |(s, n), p| (s + p, n + 1.0));
+    if n > 0.0 {
+        sum / n
+    } else {
+        sum
+    }
+}
+
+/// The solid angle of triangle `t` seen from the origin, signed by the triangle's
+/// orientation (Van Oosterom and Strackee's formula); 0 when the origin lies on it.
+fn solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
+    let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+    let numerator = a.dot(&b.cross(c));
+    let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    2.0 * numerator.atan2(denominator)
+}
+
+/// One point's winding number: clusters far enough for their bound to fit their share
+/// (`rate` times their area) are summed by moments, leaves exactly, the rest opened.
+fn descend<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    moments: &[Moment],
+    p: &Vector3<f64>,
+    rate: f64,
+    stack: &mut Vec<u32>,
+) -> Result<WindingResult, QueryError> {
+    let (mut sum, mut bound, mut work) = (0.0, 0.0, Work::default());
+    stack.clear();
+    stack.push(0);
+    while let Some(node) = stack.pop() {
+        work.nodes_visited += 1;
+        let m = moments
+            .get(node as usize)
+            .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
+        let offset = m.centroid - p;
+        let distance = offset.norm();
+        if rate > 0.0 && distance > m.radius {
+            let error = m.area * m.radius / (2.0 * PI * (distance - m.radius).powi(3));
+            if error <= rate * m.area {
+                sum += m.normal.dot(&offset) / (distance * distance * distance);
+                bound += error;
+                work.bv_disjoint += 1;
+                continue;
+            }
+        }
+        match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
+            NodeKind::Faces(faces) => {
+                for face in faces {
+                    let t = triangle(tree, face, None, Side::A)?;
+                    sum += solid_angle(&(t[0] - p), &(t[1] - p), &(t[2] - p));
+                    work.tri_separated += 1;
+                }
+            }
+            NodeKind::Children(range) => {
+                work.bv_overlap += 1;
+                stack.extend(range);
+            }
+        }
+    }
+    Ok(WindingResult {
+        value: sum / (4.0 * PI),
+        error_bound: bound,
+        work,
+    })
+}

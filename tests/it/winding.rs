@@ -1,0 +1,246 @@
+//! Winding numbers and signed distances of one posed model (`query::winding_numbers`,
+//! `query::signed_distances`): exact values on closed meshes and soups whose winding
+//! numbers are known in closed form, ray parity as an independent inside test, and the
+//! hierarchical approximation within its stated bound of the exact sum.
+// Test code outside `#[test]` functions (helpers, property bodies): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
+
+use crate::common;
+
+use nalgebra::Vector3;
+use obbtree::build::build;
+use obbtree::generate::Rng;
+use obbtree::mesh::TriMesh;
+use obbtree::query::{
+    all_ray_hits, closest_points, signed_distances, winding_numbers, Pose, QueryError, Ray,
+    WindingOptions,
+};
+
+const EXACT: WindingOptions = WindingOptions { tolerance: 0.0 };
+
+/// `mesh` with its triangles `keep`-filtered and repeated `copies` times, plus `extra`.
+fn soup(
+    mesh: &TriMesh,
+    keep: impl Fn(usize) -> bool,
+    copies: usize,
+    extra: Option<&TriMesh>,
+) -> TriMesh {
+    let mut vertices = mesh.vertices().to_vec();
+    let mut faces = Vec::new();
+    for _ in 0..copies {
+        faces.extend(
+            mesh.faces()
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| keep(*i))
+                .map(|(_, f)| *f),
+        );
+    }
+    if let Some(other) = extra {
+        let base = vertices.len() as u32;
+        vertices.extend_from_slice(other.vertices());
+        faces.extend(other.faces().iter().map(|f| f.map(|i| i + base)));
+    }
+    TriMesh::new(vertices, faces).expect("a soup")
+}
+
+#[test]
+fn winding_numbers_of_closed_meshes_and_soups_are_known_exactly() {
+    let cube = common::cube(1.0);
+    // The face at x = +1 (its two triangles) left out: from the centre it covers a sixth
+    // of the sphere of directions.
+    let open_face: Vec<usize> = cube
+        .faces()
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.iter().all(|&i| cube.vertices()[i as usize][0] == 1.0))
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(open_face.len(), 2);
+    let shifted = common::cuboid([1.0, 1.0, 1.0], [1.0, 0.0, 0.0]);
+    let cases = [
+        (
+            "cube",
+            cube.clone(),
+            vec![([0.0, 0.0, 0.0], 1.0), ([3.0, 0.2, 0.1], 0.0)],
+        ),
+        (
+            "open cube",
+            soup(&cube, |i| !open_face.contains(&i), 1, None),
+            vec![([0.0; 3], 5.0 / 6.0)],
+        ),
+        (
+            "doubled cube",
+            soup(&cube, |_| true, 2, None),
+            vec![([0.1, 0.2, 0.3], 2.0), ([0.0, 4.0, 0.0], 0.0)],
+        ),
+        (
+            "overlapping cubes",
+            soup(&cube, |_| true, 1, Some(&shifted)),
+            vec![
+                ([0.5, 0.1, 0.1], 2.0),
+                ([-0.5, 0.1, 0.1], 1.0),
+                ([1.5, 0.1, 0.1], 1.0),
+                ([2.5, 0.0, 0.0], 0.0),
+            ],
+        ),
+    ];
+    for (name, mesh, expected) in cases {
+        for options in common::all_options() {
+            let file = build(&mesh, &options, None).expect("builds");
+            let points: Vec<[f64; 3]> = expected.iter().map(|(p, _)| *p).collect();
+            for tolerance in [0.0, 1e-3] {
+                let w = winding_numbers(
+                    &file,
+                    &Pose::identity(),
+                    &points,
+                    &WindingOptions { tolerance },
+                )
+                .expect("answers");
+                for ((p, want), got) in expected.iter().zip(&w) {
+                    assert!(
+                        (got.value - want).abs() <= 1e-9 + got.error_bound,
+                        "{name} {options:?} tolerance {tolerance} at {p:?}: {} vs {want}",
+                        got.value
+                    );
+                    assert!(got.error_bound <= tolerance);
+                }
+            }
+        }
+    }
+}
+
+/// Random points of a closed mesh's neighbourhood: inside exactly where a ray from the
+/// point crosses the surface an odd number of times.
+#[test]
+fn inside_agrees_with_ray_parity_on_closed_meshes() {
+    let meshes = [
+        ("sphere", common::uv_sphere(1.0, 16, 24)),
+        ("cuboid", common::cuboid([0.5, 1.0, 0.25], [0.1, -0.2, 0.0])),
+    ];
+    let mut rng = Rng::new(4);
+    for (name, mesh) in meshes {
+        let file = build(&mesh, &Default::default(), None).expect("builds");
+        let pose = common::turned_pose(2, 0.5);
+        let points: Vec<[f64; 3]> = (0..400)
+            .map(|_| {
+                pose.apply(&(Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 1.3))
+                    .into()
+            })
+            .collect();
+        let rays: Vec<Ray> = points
+            .iter()
+            .map(|p| Ray {
+                origin: *p,
+                direction: [0.3, 0.5, 0.81],
+            })
+            .collect();
+        let crossings = all_ray_hits(&file, &pose, &rays, f64::INFINITY).expect("answers");
+        for tolerance in [0.0, 1e-2] {
+            let w = winding_numbers(&file, &pose, &points, &WindingOptions { tolerance })
+                .expect("answers");
+            for ((p, w), hits) in points.iter().zip(&w).zip(&crossings) {
+                assert_eq!(
+                    w.inside(),
+                    hits.hits.len() % 2 == 1,
+                    "{name} at {p:?}: {w:?}"
+                );
+                // Closed: 0 or 1 within the stated bound.
+                let target = if w.inside() { 1.0 } else { 0.0 };
+                assert!(
+                    (w.value - target).abs() <= 1e-9 + w.error_bound,
+                    "{name} at {p:?}: {w:?}"
+                );
+            }
+        }
+    }
+}
+
+/// On an open model (the cow, with holes) the approximation stays within its stated bound
+/// of the exact sum, for every tree type and several tolerances, and works less.
+#[test]
+fn the_approximation_stays_within_its_bound_of_the_exact_sum() {
+    let cow = common::cow();
+    let mut rng = Rng::new(6);
+    let points: Vec<[f64; 3]> = (0..300)
+        .map(|k| {
+            let r = if k % 3 == 0 { 3.0 } else { 0.6 };
+            [rng.signed() * r, rng.signed() * r, rng.signed() * r]
+        })
+        .collect();
+    for options in common::all_options() {
+        let file = build(&cow, &options, None).expect("builds");
+        let pose = common::turned_pose(1, 0.2);
+        let exact = winding_numbers(&file, &pose, &points, &EXACT).expect("answers");
+        assert!(exact.iter().all(|w| w.error_bound == 0.0));
+        for tolerance in [1e-1, 1e-2, 1e-4] {
+            let near = winding_numbers(&file, &pose, &points, &WindingOptions { tolerance })
+                .expect("answers");
+            let (mut ours, mut theirs) = (0, 0);
+            for (a, e) in near.iter().zip(&exact) {
+                assert!(a.error_bound <= tolerance, "{options:?}: {a:?}");
+                assert!(
+                    (a.value - e.value).abs() <= a.error_bound + 1e-10,
+                    "{options:?} {tolerance}: {a:?} vs {e:?}"
+                );
+                ours += a.work.tri_tests() + a.work.bv_tests();
+                theirs += e.work.tri_tests() + e.work.bv_tests();
+            }
+            if tolerance >= 1e-2 {
+                assert!(
+                    ours * 2 < theirs,
+                    "{options:?} {tolerance}: {ours} vs {theirs}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn signed_distances_are_closest_distances_negative_inside() {
+    let mesh = common::uv_sphere(1.0, 12, 16);
+    let file = build(&mesh, &Default::default(), None).expect("builds");
+    let pose = common::turned_pose(0, 0.3);
+    let points: Vec<[f64; 3]> = [
+        [0.0, 0.0, 0.0],
+        [0.5, 0.1, 0.0],
+        [2.0, 0.0, 0.0],
+        [0.0, -1.5, 0.5],
+    ]
+    .iter()
+    .map(|p| pose.apply(&Vector3::from(*p)).into())
+    .collect();
+    let signed = signed_distances(&file, &pose, &points, &Default::default()).expect("answers");
+    let closest = closest_points(&file, &pose, &points, &Default::default()).expect("answers");
+    for (k, (s, c)) in signed.iter().zip(&closest).enumerate() {
+        let sign = if k < 2 { -1.0 } else { 1.0 };
+        assert_eq!(*s, sign * c.distance(), "point {k}");
+    }
+}
+
+#[test]
+fn bad_points_and_tolerances_are_refused() {
+    let file = build(&common::cube(0.5), &Default::default(), None).expect("builds");
+    let pose = Pose::identity();
+    let error = winding_numbers(&file, &pose, &[[0.0; 3], [f64::NAN, 0.0, 0.0]], &EXACT)
+        .expect_err("refused");
+    assert!(
+        matches!(error, QueryError::BadInput { index: 1, .. }),
+        "{error}"
+    );
+    for tolerance in [-1.0, f64::NAN] {
+        let error = winding_numbers(&file, &pose, &[[0.0; 3]], &WindingOptions { tolerance })
+            .expect_err("refused");
+        assert!(
+            matches!(
+                error,
+                QueryError::BadOption {
+                    name: "tolerance",
+                    ..
+                }
+            ),
+            "{error}"
+        );
+    }
+    assert!(signed_distances(&file, &pose, &[[f64::INFINITY; 3]], &EXACT).is_err());
+}
