@@ -51,7 +51,9 @@ pub use engine::QueryContext;
 pub use pair_query::PairQuery;
 pub use ray::{all_ray_hits, cast_rays, Ray, RayHit, RayHits, RayMode, RayOptions, RayResult};
 pub use span::{SpanOptions, SpanResult};
-pub use winding::{signed_distances, winding_numbers, WindingOptions, WindingResult};
+pub use winding::{
+    signed_distances, winding_numbers, WindingAccuracy, WindingOptions, WindingResult,
+};
 pub use work::Work;
 
 /// One of the two models of a pair query: A, in whose frame results are given, or B.

@@ -14,23 +14,46 @@ use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
 use crate::tree::{NodeDefect, NodeKind, TreeView};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
-use std::cmp::Ordering;
+use std::cmp::Ordering::Greater;
 use std::f64::consts::PI;
 
 /// How winding numbers are asked.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WindingOptions {
-    /// The largest error allowed in each winding number (`≥ 0`; 0 sums every triangle
-    /// exactly). Far clusters of triangles are summed by their dipole moment while the
-    /// proven bound on the error that adds stays within this.
-    pub tolerance: f64,
+    /// Which far clusters of triangles are summed by their moments rather than triangle by
+    /// triangle.
+    pub accuracy: WindingAccuracy,
 }
 
-impl Default for WindingOptions {
+/// How exactly a winding number is summed: the speed and error of each are measured in
+/// `docs/results/2026-11-26-winding-numbers.md`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WindingAccuracy {
+    /// Every triangle's solid angle: the reference, and the cost of one per triangle.
+    Exact,
+    /// Within `tolerance` (`> 0`) of the exact sum, proven: a cluster is summed by its
+    /// moments only while the bound on what that errs by fits its share of the tolerance
+    /// by area. Worst cases add up in the proof, not in practice: the errors measured are
+    /// far below the tolerance, and so is the speed.
+    Bounded {
+        /// The largest error allowed.
+        tolerance: f64,
+    },
+    /// Barill et al.'s rule: a cluster seen from more than `beta` (`> 1`) times its radius
+    /// is summed by its moments. The fast choice (as libigl's default, `beta` 2); its
+    /// error is not bounded beforehand ([`WindingResult::error_bound`] still bounds what it
+    /// did), and is measured small in practice.
+    Beta {
+        /// How far, in cluster radii, a cluster must be.
+        beta: f64,
+    },
+}
+
+impl Default for WindingAccuracy {
     fn default() -> Self {
-        WindingOptions { tolerance: 1e-3 }
+        WindingAccuracy::Beta { beta: 2.0 }
     }
 }
 
@@ -40,9 +63,10 @@ pub struct WindingResult {
     /// The generalised winding number: 1 inside a closed outward-facing surface, 0
     /// outside, between for open surfaces; the point is inside where it is `> 0.5`.
     pub value: f64,
-    /// A bound on `|value − exact|` from the clusters summed by their dipole moments (0
-    /// when every triangle was summed exactly), at most [`WindingOptions::tolerance`];
-    /// rounding comes on top.
+    /// A proven bound on `|value − exact|` from the clusters summed by their moments: 0
+    /// for [`WindingAccuracy::Exact`], at most the tolerance for
+    /// [`WindingAccuracy::Bounded`], often far above the error made for
+    /// [`WindingAccuracy::Beta`]. Rounding comes on top.
     pub error_bound: f64,
     /// Work done: I counts clusters opened, D clusters summed by their moments, S
     /// triangles summed exactly.
@@ -60,16 +84,17 @@ impl WindingResult {
 /// `points` (world frame), computed in parallel.
 ///
 /// Triangles count with the orientation of their corners' order (counterclockwise seen
-/// from outside is outward). Far clusters of triangles are summed by their area-weighted
-/// normal at their centroid: for a cluster of area `A` within radius `r` of its centroid,
-/// seen from `R > r` away, that errs by at most `A r / (2π (R − r)³)` (the integrand's
-/// gradient is at most `2 / distance³`), and a cluster is summed so only while that bound
-/// is within its share of the tolerance by area.
+/// from outside is outward). Far clusters of triangles are summed by a first-order
+/// expansion of the solid-angle kernel about their centroid (their area-weighted normal
+/// and its spread over the cluster, Barill et al.'s order 2): for a cluster of area `A`
+/// within radius `r` of its centroid, seen from `R > r` away, that errs by at most
+/// `3 A r² / (4π (R − r)⁴)` (the kernel's second derivatives are at most `6 / distance⁴`).
+/// Which clusters are summed so is [`WindingOptions::accuracy`]'s choice.
 ///
 /// # Errors
 ///
 /// - [`QueryError::BadInput`] for a query point with a non-finite coordinate,
-///   [`QueryError::BadOption`] for a negative or NaN tolerance.
+///   [`QueryError::BadOption`] for a tolerance not above 0 or a `beta` not above 1.
 /// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
 ///
 /// # Examples
@@ -90,41 +115,47 @@ pub fn winding_numbers(
     points: &[[f64; 3]],
     options: &WindingOptions,
 ) -> Result<Vec<WindingResult>, QueryError> {
-    if options
-        .tolerance
-        .partial_cmp(&0.0)
-        .is_none_or(Ordering::is_lt)
-    {
-        return Err(QueryError::BadOption {
-            name: "tolerance",
-            requirement: "0 or more",
-            value: options.tolerance,
-        });
+    let bad = |name, requirement, value| QueryError::BadOption {
+        name,
+        requirement,
+        value,
+    };
+    // (NaN fails too.)
+    match options.accuracy {
+        WindingAccuracy::Bounded { tolerance } if tolerance.partial_cmp(&0.0) != Some(Greater) => {
+            return Err(bad("tolerance", "greater than 0", tolerance))
+        }
+        WindingAccuracy::Beta { beta } if beta.partial_cmp(&1.0) != Some(Greater) => {
+            return Err(bad("beta", "greater than 1", beta))
+        }
+        _ => {}
     }
     check_points(points)?;
     /// The typed descent, run for every point.
     struct Visit<'q> {
         pose: &'q Pose,
         points: &'q [[f64; 3]],
-        tolerance: f64,
+        accuracy: WindingAccuracy,
     }
     impl TreeVisitor for Visit<'_> {
         type Output = Result<Vec<WindingResult>, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             let moments = moments(&tree)?;
-            let total = moments.first().map_or(0.0, |m| m.area);
-            // Bound per unit area: a cluster of area A may err by A times this.
-            let rate = if total > 0.0 {
-                self.tolerance / total
-            } else {
-                0.0
+            let rule = match self.accuracy {
+                WindingAccuracy::Exact => Rule::Exact,
+                // Bound per unit area: a cluster of area A may err by A times this.
+                WindingAccuracy::Bounded { tolerance } => match moments.first().map(|m| m.area) {
+                    Some(total) if total > 0.0 => Rule::Rate(tolerance / total),
+                    _ => Rule::Exact,
+                },
+                WindingAccuracy::Beta { beta } => Rule::Beta(beta),
             };
             let to_model = Pose::relative(self.pose, &Pose::identity());
             self.points
                 .par_iter()
                 .map_init(Vec::new, |stack, p| {
                     let local = to_model.apply(&Vector3::from(*p));
-                    descend(&tree, &moments, &local, rate, stack)
+                    descend(&tree, &moments, &local, rule, stack)
                 })
                 .collect()
         }
@@ -132,7 +163,7 @@ pub fn winding_numbers(
     model.visit(Visit {
         pose,
         points,
-        tolerance: options.tolerance,
+        accuracy: options.accuracy,
     })?
 }
 
@@ -178,13 +209,15 @@ pub fn signed_distances(
 }
 
 /// What a cluster of triangles (a node's) looks like from afar: its area, its area-weighted
-/// normal `Σ A n`, its area-weighted centroid, and the radius about that centroid within
-/// which all its corners lie (model frame).
+/// normal `Σ A n`, its area-weighted centroid `c`, the spread `Σ A n (cₜ − c)ᵀ` of its
+/// triangles' centroids `cₜ` about it, and the radius about `c` within which all its
+/// corners lie (model frame).
 #[derive(Clone, Copy, Debug, Default)]
 struct Moment {
     area: f64,
     normal: Vector3<f64>,
     centroid: Vector3<f64>,
+    spread: Matrix3<f64>,
     radius: f64,
 }
 
@@ -195,19 +228,22 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
     for node in (0..tree.nodes().len() as u32).rev() {
         let m = match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
             NodeKind::Faces(faces) => {
-                let mut corners = Vec::new();
-                let (mut area, mut normal, mut weighted) =
-                    (0.0, Vector3::zeros(), Vector3::zeros());
+                // Each triangle's area-weighted normal and centroid, and its corners.
+                let (mut parts, mut corners) = (Vec::new(), Vec::new());
                 for face in faces {
                     let t = triangle(tree, face, None, Side::A)?;
                     let n = (t[1] - t[0]).cross(&(t[2] - t[0])) / 2.0;
-                    let a = n.norm();
-                    area += a;
-                    normal += n;
-                    weighted += (t[0] + t[1] + t[2]) * (a / 3.0);
+                    parts.push((n, (t[0] + t[1] + t[2]) / 3.0));
                     corners.extend(t);
                 }
+                let area = parts.iter().map(|(n, _)| n.norm()).sum::<f64>();
+                let normal = parts.iter().map(|(n, _)| n).sum();
+                let weighted = parts.iter().map(|(n, c)| c * n.norm()).sum();
                 let centroid = centre(weighted, area, corners.iter().copied());
+                let spread = parts
+                    .iter()
+                    .map(|(n, c)| n * (c - centroid).transpose())
+                    .sum();
                 let radius = corners
                     .iter()
                     .map(|c| (c - centroid).norm())
@@ -216,6 +252,7 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                     area,
                     normal,
                     centroid,
+                    spread,
                     radius,
                 }
             }
@@ -227,6 +264,11 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                 let normal = kids.iter().map(|k| k.normal).sum();
                 let weighted = kids.iter().map(|k| k.centroid * k.area).sum();
                 let centroid = centre(weighted, area, kids.iter().map(|k| k.centroid));
+                // Each child's spread, moved from its centroid to the parent's.
+                let spread = kids
+                    .iter()
+                    .map(|k| k.spread + k.normal * (k.centroid - centroid).transpose())
+                    .sum();
                 let radius = kids
                     .iter()
                     .map(|k| (k.centroid - centroid).norm() + k.radius)
@@ -235,6 +277,7 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                     area,
                     normal,
                     centroid,
+                    spread,
                     radius,
                 }
             }
@@ -272,13 +315,24 @@ fn solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
     2.0 * numerator.atan2(denominator)
 }
 
-/// One point's winding number: clusters far enough for their bound to fit their share
-/// (`rate` times their area) are summed by moments, leaves exactly, the rest opened.
+/// Which clusters a descent sums by their moments.
+#[derive(Clone, Copy, Debug)]
+enum Rule {
+    /// None.
+    Exact,
+    /// Those whose error bound is within this many times their area.
+    Rate(f64),
+    /// Those farther than this many times their radius.
+    Beta(f64),
+}
+
+/// One point's winding number: clusters the rule accepts are summed by moments, leaves
+/// exactly, the rest opened.
 fn descend<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     moments: &[Moment],
     p: &Vector3<f64>,
-    rate: f64,
+    rule: Rule,
     stack: &mut Vec<u32>,
 ) -> Result<WindingResult, QueryError> {
     let (mut sum, mut bound, mut work) = (0.0, 0.0, Work::default());
@@ -291,10 +345,21 @@ fn descend<B: BoundingVolume>(
             .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
         let offset = m.centroid - p;
         let distance = offset.norm();
-        if rate > 0.0 && distance > m.radius {
-            let error = m.area * m.radius / (2.0 * PI * (distance - m.radius).powi(3));
-            if error <= rate * m.area {
-                sum += m.normal.dot(&offset) / (distance * distance * distance);
+        if distance > m.radius {
+            let gap = distance - m.radius;
+            let error = 3.0 * m.area * m.radius * m.radius / (4.0 * PI * gap * gap * gap * gap);
+            let accept = match rule {
+                Rule::Exact => false,
+                Rule::Rate(rate) => error <= rate * m.area,
+                Rule::Beta(beta) => distance > beta * m.radius,
+            };
+            if accept {
+                // The kernel g(x) = (x − p) / |x − p|³ to first order about the centroid:
+                // g·N, plus the gradient's inner product with the spread.
+                let d3 = distance * distance * distance;
+                let u = offset;
+                sum += m.normal.dot(&u) / d3 + m.spread.trace() / d3
+                    - 3.0 * u.dot(&(m.spread * u)) / (d3 * distance * distance);
                 bound += error;
                 work.bv_disjoint += 1;
                 continue;

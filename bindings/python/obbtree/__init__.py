@@ -20,7 +20,8 @@ A pose is a (4, 4) rigid matrix, 12 numbers (rotation row-major, then translatio
 ``(R, t)`` pair; a batch is (N, 4, 4) or (N, 12). A world point is ``R @ p + t``.
 
 Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``, and
-``closest`` and ``ray`` (one model against many points or rays); classes ``Tree``, ``Scene`` and the result
+``closest``, ``ray``, ``winding_number`` and ``signed_distance`` (one model against
+many points or rays); classes ``Tree``, ``Scene`` and the result
 classes; exceptions ``Error`` and its subclasses
 ``MeshError``, ``FormatError``, ``PoseError``, ``SceneError``, ``OptionError``,
 ``FileError``.
@@ -52,6 +53,8 @@ from ._obbtree import (
     _build,
     _closest,
     _ray,
+    _signed_distance,
+    _winding_number,
     collide,
     distance,
     open,
@@ -71,6 +74,8 @@ __all__ = [
     "ray",
     "RayResult",
     "RayHits",
+    "winding_number",
+    "signed_distance",
     "Tree",
     "Scene",
     "CollideResult",
@@ -201,6 +206,16 @@ class ClosestResult:
 _FEATURES = np.array(["face", "edge", "vertex", ""])
 
 
+def _point_rows(points: Any) -> np.ndarray:
+    """``points`` as a contiguous (N, 3) float64 array; one point (3,) is one row."""
+    array = np.asarray(points, dtype=np.float64)
+    if array.shape == (3,):
+        array = array.reshape(1, 3)
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise OptionError(f"points must be an (N, 3) array or one point (3,), got shape {array.shape}")
+    return np.ascontiguousarray(array)
+
+
 def closest(
     tree: Tree,
     pose: Any,
@@ -219,13 +234,8 @@ def closest(
     Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points or
     a ``max_distance`` not above 0, ``PoseError`` for a pose that is not a rigid motion.
     """
-    array = np.asarray(points, dtype=np.float64)
-    if array.shape == (3,):
-        array = array.reshape(1, 3)
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise OptionError(f"points must be an (N, 3) array or one point (3,), got shape {array.shape}")
     distance, point, tri, feature, index = _closest(
-        tree, pose, np.ascontiguousarray(array), float(max_distance), orthonormalize
+        tree, pose, _point_rows(points), float(max_distance), orthonormalize
     )
     arrays = [distance, point, tri, _FEATURES[feature], index]
     for a in arrays:
@@ -332,3 +342,66 @@ def ray(
     for field in dataclasses.fields(result):
         getattr(result, field.name).flags.writeable = False
     return result
+
+
+def winding_number(
+    tree: Tree,
+    pose: Any,
+    points: Any,
+    *,
+    beta: float = 2.0,
+    tolerance: Optional[float] = None,
+    orthonormalize: bool = False,
+) -> np.ndarray:
+    """The generalised winding number of a posed model at each query point: (N,) float64.
+
+    1 inside a closed outward-facing surface, 0 outside, between for surfaces with holes;
+    a point is inside where it is above 0.5, which holds for polygon soups too (holes,
+    duplicate and self-intersecting triangles). ``points`` is an (N, 3) array of world
+    points or one point (3,); computed in parallel with the GIL released.
+
+    Far clusters of triangles are summed by their moments (Barill et al. 2018): by default
+    those seen from more than ``beta`` times their radius (fast, as libigl's fast winding
+    number; the error is not bounded beforehand and is measured small). With
+    ``tolerance`` each value is instead proven within ``tolerance`` of the exact sum
+    (slower: the proof adds worst cases), and ``tolerance=0`` sums every triangle exactly.
+
+    Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points
+    (naming the first), ``beta`` not above 1 or a negative ``tolerance``; ``PoseError`` for a
+    pose that is not a rigid motion.
+    """
+    value, _bound = _winding_number(tree, pose, _point_rows(points), float(beta),
+                                    _tolerance(tolerance), orthonormalize)
+    value.flags.writeable = False
+    return value
+
+
+def signed_distance(
+    tree: Tree,
+    pose: Any,
+    points: Any,
+    *,
+    beta: float = 2.0,
+    tolerance: Optional[float] = None,
+    orthonormalize: bool = False,
+) -> np.ndarray:
+    """The signed distance of a posed model at each query point: (N,) float64, the
+    distance to the closest surface point (as ``closest`` finds it), negative where the
+    winding number (as ``winding_number`` computes it with ``beta`` or ``tolerance``) is
+    above 0.5.
+
+    Raises as ``winding_number``.
+    """
+    value = _signed_distance(tree, pose, _point_rows(points), float(beta),
+                             _tolerance(tolerance), orthonormalize)
+    value.flags.writeable = False
+    return value
+
+
+def _tolerance(tolerance: Optional[float]) -> Optional[float]:
+    """A tolerance as the native call takes it: ``None``, or a float that is not negative."""
+    if tolerance is None:
+        return None
+    if not tolerance >= 0:
+        raise OptionError(f"tolerance must be 0 or more, got {tolerance}")
+    return float(tolerance)

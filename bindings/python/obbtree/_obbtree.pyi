@@ -249,6 +249,22 @@ def _ray(
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
 ]: ...
+def _winding_number(
+    tree: Tree,
+    pose: Poses,
+    points: npt.NDArray[np.float64],
+    beta: float,
+    tolerance: Optional[float],
+    orthonormalize: bool,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def _signed_distance(
+    tree: Tree,
+    pose: Poses,
+    points: npt.NDArray[np.float64],
+    beta: float,
+    tolerance: Optional[float],
+    orthonormalize: bool,
+) -> npt.NDArray[np.float64]: ...
 def _time_rust_loop(
     a: Tree, poses_a: Poses, b: Tree, poses_b: Poses, query: str, repeat: int
 ) -> float: ...

@@ -30,19 +30,7 @@ pub fn _closest<'py>(
 )> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
-    let view = points.as_array();
-    if view.ncols() != 3 {
-        return Err(Failure::new(
-            crate::errors::Kind::Option,
-            format!("points must be an (N, 3) array, got (N, {})", view.ncols()),
-        )
-        .into());
-    }
-    let query: Vec<[f64; 3]> = view
-        .rows()
-        .into_iter()
-        .map(|r| [r[0], r[1], r[2]])
-        .collect();
+    let query = crate::winding::point_rows(&points)?;
     let options = ClosestOptions { max_distance };
     let answers =
         py.detach(|| closest_points(&file, &pose, &query, &options).map_err(Failure::from))?;

@@ -13,6 +13,7 @@ mod queries;
 mod ray;
 mod scene;
 mod tree;
+mod winding;
 
 use pyo3::prelude::*;
 
@@ -140,6 +141,8 @@ fn _obbtree(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::span, m)?)?;
     m.add_function(wrap_pyfunction!(closest::_closest, m)?)?;
     m.add_function(wrap_pyfunction!(ray::_ray, m)?)?;
+    m.add_function(wrap_pyfunction!(winding::_winding_number, m)?)?;
+    m.add_function(wrap_pyfunction!(winding::_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(queries::_time_rust_loop, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

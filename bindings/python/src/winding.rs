@@ -1,0 +1,83 @@
+//! `obbtree.winding_number` and `obbtree.signed_distance`: inside or outside one posed model.
+
+use crate::errors::{Failure, Kind};
+use crate::poses::single_pose;
+use crate::tree::Tree;
+use numpy::{PyArray1, PyReadonlyArray2};
+use obbtree::query::{signed_distances, winding_numbers, WindingAccuracy, WindingOptions};
+use pyo3::prelude::*;
+
+/// `points` as rows of three, or the error naming their shape.
+pub fn point_rows(points: &PyReadonlyArray2<'_, f64>) -> Result<Vec<[f64; 3]>, Failure> {
+    let view = points.as_array();
+    if view.ncols() != 3 {
+        return Err(Failure::new(
+            Kind::Option,
+            format!("points must be an (N, 3) array, got (N, {})", view.ncols()),
+        ));
+    }
+    Ok(view
+        .rows()
+        .into_iter()
+        .map(|r| [r[0], r[1], r[2]])
+        .collect())
+}
+
+/// The options of `beta` and `tolerance` as `obbtree.winding_number` documents them:
+/// `tolerance` given, 0 for the exact sum, else within it; else Barill's rule at `beta`.
+fn accuracy(beta: f64, tolerance: Option<f64>) -> WindingOptions {
+    let accuracy = match tolerance {
+        Some(t) if t == 0.0 => WindingAccuracy::Exact,
+        Some(tolerance) => WindingAccuracy::Bounded { tolerance },
+        None => WindingAccuracy::Beta { beta },
+    };
+    WindingOptions { accuracy }
+}
+
+/// The native half of `obbtree.winding_number` (which documents it): `points` an (N, 3)
+/// float64 array. Returns the (N,) winding numbers and their (N,) error bounds.
+#[pyfunction]
+#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize))]
+#[allow(clippy::type_complexity)]
+pub fn _winding_number<'py>(
+    py: Python<'py>,
+    tree: PyRef<'_, Tree>,
+    pose: &Bound<'py, PyAny>,
+    points: PyReadonlyArray2<'py, f64>,
+    beta: f64,
+    tolerance: Option<f64>,
+    orthonormalize: bool,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let file = tree.file()?;
+    let pose = single_pose("pose", pose, orthonormalize)?;
+    let query = point_rows(&points)?;
+    let options = accuracy(beta, tolerance);
+    let answers =
+        py.detach(|| winding_numbers(&file, &pose, &query, &options).map_err(Failure::from))?;
+    Ok((
+        PyArray1::from_iter(py, answers.iter().map(|w| w.value)),
+        PyArray1::from_iter(py, answers.iter().map(|w| w.error_bound)),
+    ))
+}
+
+/// The native half of `obbtree.signed_distance` (which documents it): the (N,) signed
+/// distances at an (N, 3) float64 array of points.
+#[pyfunction]
+#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize))]
+pub fn _signed_distance<'py>(
+    py: Python<'py>,
+    tree: PyRef<'_, Tree>,
+    pose: &Bound<'py, PyAny>,
+    points: PyReadonlyArray2<'py, f64>,
+    beta: f64,
+    tolerance: Option<f64>,
+    orthonormalize: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let file = tree.file()?;
+    let pose = single_pose("pose", pose, orthonormalize)?;
+    let query = point_rows(&points)?;
+    let options = accuracy(beta, tolerance);
+    let answers =
+        py.detach(|| signed_distances(&file, &pose, &query, &options).map_err(Failure::from))?;
+    Ok(PyArray1::from_vec(py, answers))
+}
