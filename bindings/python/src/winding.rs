@@ -27,7 +27,7 @@ pub fn point_rows(points: &PyReadonlyArray2<'_, f64>) -> Result<Vec<[f64; 3]>, F
 /// `tolerance` given, 0 for the exact sum, else within it; else Barill's rule at `beta`.
 fn accuracy(beta: f64, tolerance: Option<f64>) -> WindingOptions {
     let accuracy = match tolerance {
-        Some(t) if t == 0.0 => WindingAccuracy::Exact,
+        Some(0.0) => WindingAccuracy::Exact,
         Some(tolerance) => WindingAccuracy::Bounded { tolerance },
         None => WindingAccuracy::Beta { beta },
     };
