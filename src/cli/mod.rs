@@ -8,6 +8,7 @@ mod experiment;
 mod files;
 mod generate;
 mod info;
+mod inside;
 mod plot;
 mod poses;
 mod print;
@@ -51,6 +52,7 @@ enum Command {
     Span(query::SpanArgs),
     Closest(closest::ClosestArgs),
     Ray(ray::RayArgs),
+    Inside(inside::InsideArgs),
     Scene(scene::SceneArgs),
     Demo(demo::DemoArgs),
     Experiment(experiment::ExperimentArgs),
@@ -146,6 +148,7 @@ pub fn main() -> ExitCode {
         Command::Span(args) => query::span(&args),
         Command::Closest(args) => closest::run(&args),
         Command::Ray(args) => ray::run(&args),
+        Command::Inside(args) => inside::run(&args),
         Command::Scene(args) => scene::run(&args).map(|_| ()),
         Command::Demo(args) => demo::run(&args),
         Command::Experiment(args) => experiment::run(&args),

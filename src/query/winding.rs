@@ -78,6 +78,16 @@ impl WindingResult {
     pub fn inside(&self) -> bool {
         self.value > 0.5
     }
+
+    /// `distance` (to the model's surface) made negative where the point is inside: the
+    /// signed distance.
+    pub fn signed(&self, distance: f64) -> f64 {
+        if self.inside() {
+            -distance
+        } else {
+            distance
+        }
+    }
 }
 
 /// The winding number of `model`, posed by `pose` (model frame to world), at each of
@@ -197,14 +207,7 @@ pub fn signed_distances(
     Ok(winding
         .iter()
         .zip(&closest)
-        .map(|(w, c)| {
-            let d = c.distance();
-            if w.inside() {
-                -d
-            } else {
-                d
-            }
-        })
+        .map(|(w, c)| w.signed(c.distance()))
         .collect())
 }
 

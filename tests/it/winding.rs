@@ -269,3 +269,66 @@ fn bad_points_and_tolerances_are_refused() {
     }
     assert!(signed_distances(&file, &pose, &[[f64::INFINITY; 3]], &EXACT).is_err());
 }
+
+/// `obbtree inside` prints what the library answers and refuses bad input with one line
+/// and status 1.
+#[test]
+fn the_cli_answers_as_the_library() {
+    use common::cli::{assert_bad_input, cow, obbtree, scratch, stderr};
+    let dir = scratch("inside");
+    let path = dir.join("points.txt");
+    std::fs::write(&path, "# x y z\n0 0 0\n\n0.3,0.1,0\n2 2 2\n").expect("writes");
+    let points = [[0.0, 0.0, 0.0], [0.3, 0.1, 0.0], [2.0, 2.0, 2.0]];
+    let file = build(&common::cow(), &Default::default(), None).expect("builds");
+    for (flags, accuracy) in [
+        (vec![], WindingAccuracy::Beta { beta: 2.0 }),
+        (vec!["--beta", "3"], WindingAccuracy::Beta { beta: 3.0 }),
+        (vec!["--tolerance", "0"], WindingAccuracy::Exact),
+        (
+            vec!["--tolerance", "0.01"],
+            WindingAccuracy::Bounded { tolerance: 0.01 },
+        ),
+    ] {
+        let cow_path = cow();
+        let mut args = vec![
+            "inside",
+            cow_path.as_str(),
+            "--points",
+            path.to_str().expect("a path"),
+            "--distance",
+            "--json",
+        ];
+        args.extend(flags);
+        let o = obbtree(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(|l| serde_json::from_str(l).expect("JSON"))
+            .collect();
+        let options = WindingOptions { accuracy };
+        let w = winding_numbers(&file, &Pose::identity(), &points, &options).expect("answers");
+        let s = signed_distances(&file, &Pose::identity(), &points, &options).expect("answers");
+        assert_eq!(lines.len(), 3);
+        for ((line, w), s) in lines.iter().zip(&w).zip(&s) {
+            let same = |a: &serde_json::Value, b: f64| {
+                (a.as_f64().expect("a number") - b).abs()
+                    <= 4.0 * f64::EPSILON * b.abs().max(1e-300)
+            };
+            assert!(same(&line["winding_number"], w.value), "{line}");
+            assert_eq!(line["inside"], w.inside());
+            assert!(same(&line["signed_distance"], *s), "{line}");
+        }
+    }
+    let cow_path = cow();
+    for (args, needle) in [
+        (vec!["--point", "1,2"], "--point"),
+        (vec!["--point", "0,0,nan"], "query point 0"),
+        (vec!["--point", "0,0,0", "--beta", "0.5"], "beta"),
+        (vec!["--point", "0,0,0", "--tolerance", "-1"], "tolerance"),
+        (vec![], "--points"),
+    ] {
+        let mut every = vec!["inside", cow_path.as_str()];
+        every.extend(args);
+        assert_bad_input(&obbtree(&every), needle);
+    }
+}
