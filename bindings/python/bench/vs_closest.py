@@ -26,35 +26,13 @@ limited (RAYON_NUM_THREADS for obbtree; libigl and Open3D use their own thread p
 from __future__ import annotations
 
 import argparse
-import pathlib
 import sys
 import time
 
 import numpy as np
 
 import obbtree
-
-HERE = pathlib.Path(__file__).resolve().parent
-REPO = HERE.parents[2]
-SHARED = REPO.parent / "shared" / "meshes"
-
-
-def meshes():
-    """(name, path) of the bundled cow and the shared meshes that exist."""
-    out = [("cow", REPO / "assets" / "cow.obj")]
-    for name in ["bunny.obj", "fandisk.stl", "pig.stl", "cad/boeing.obj", "cad/ALSTOM_TEST4.obj", "cad/anchor.obj"]:
-        path = SHARED / name
-        if path.exists():
-            out.append((pathlib.Path(name).stem, path))
-        else:
-            print(f"skipping {name}: {path} not found", file=sys.stderr)
-    return out
-
-
-def mesh_of(tree):
-    """Vertices (float64) and faces in input order, from an f64 tree's zero-copy views."""
-    order = np.argsort(tree.source_ids)
-    return np.array(tree.vertices, dtype=np.float64), np.array(tree.faces[order], dtype=np.int64)
+from common import median_seconds, mesh_of, meshes  # noqa: E402
 
 
 def query_points(v, f, n, rng):
@@ -69,15 +47,6 @@ def query_points(v, f, n, rng):
     centre, half = (lo + hi) / 2, (hi - lo) / 2
     far = centre + rng.uniform(-3, 3, (n, 3)) * half
     return {"near": near, "far": far}
-
-
-def median_seconds(run, repeat):
-    times = []
-    for _ in range(repeat):
-        started = time.perf_counter()
-        result = run()
-        times.append(time.perf_counter() - started)
-    return float(np.median(times)), result
 
 
 class Igl:

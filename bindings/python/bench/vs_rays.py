@@ -24,39 +24,14 @@ from __future__ import annotations
 
 import argparse
 import os
-import pathlib
 import sys
-import time
 
 os.environ.setdefault("RAYON_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
 import obbtree  # noqa: E402
-
-HERE = pathlib.Path(__file__).resolve().parent
-REPO = HERE.parents[2]
-SHARED = REPO.parent / "shared" / "meshes"
-NAMES = ["bunny.obj", "fandisk.stl", "pig.stl", "cad/boeing.obj", "cad/ALSTOM_TEST4.obj",
-         "cad/anchor.obj"]
-
-
-def meshes():
-    """(name, path) of the bundled cow and the shared meshes that exist."""
-    out = [("cow", REPO / "assets" / "cow.obj")]
-    for name in NAMES:
-        path = SHARED / name
-        if path.exists():
-            out.append((pathlib.Path(name).stem, path))
-        else:
-            print(f"skipping {name}: {path} not found", file=sys.stderr)
-    return out
-
-
-def mesh_of(tree):
-    """Vertices (float64) and faces in input order, from an f64 tree's zero-copy views."""
-    order = np.argsort(tree.source_ids)
-    return np.array(tree.vertices, dtype=np.float64), np.array(tree.faces[order], dtype=np.int64)
+from common import median_seconds, mesh_of, meshes  # noqa: E402
 
 
 def ray_sets(v, n, rng):
@@ -73,15 +48,6 @@ def ray_sets(v, n, rng):
     origins = centre + 2 * radius * d / np.linalg.norm(d, axis=1)[:, None]
     random = (origins, lo + (hi - lo) * rng.random((n, 3)) - origins)
     return {"camera": camera, "random": random}
-
-
-def median_seconds(run, repeat):
-    times = []
-    for _ in range(repeat):
-        started = time.perf_counter()
-        result = run()
-        times.append(time.perf_counter() - started)
-    return float(np.median(times)), result
 
 
 class Embree:
