@@ -9,6 +9,7 @@
 
 use super::closest::{closest_points, ClosestOptions};
 use super::engine::{corrupt, triangle};
+use super::triangle::Triangle;
 use super::{check_points, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
@@ -94,12 +95,13 @@ impl WindingResult {
 /// `points` (world frame), computed in parallel.
 ///
 /// Triangles count with the orientation of their corners' order (counterclockwise seen
-/// from outside is outward). Far clusters of triangles are summed by a first-order
+/// from outside is outward). Far clusters of triangles are summed by a second-order
 /// expansion of the solid-angle kernel about their centroid (their area-weighted normal
-/// and its spread over the cluster, Barill et al.'s order 2): for a cluster of area `A`
-/// within radius `r` of its centroid, seen from `R > r` away, that errs by at most
-/// `3 A r² / (4π (R − r)⁴)` (the kernel's second derivatives are at most `6 / distance⁴`).
-/// Which clusters are summed so is [`WindingOptions::accuracy`]'s choice.
+/// and its first and second moments over the cluster, Barill et al.'s order 3, libigl's
+/// default): for a cluster of area `A` within radius `r` of its centroid, seen from
+/// `R > r` away, that errs by at most `A r³ / (π (R − r)⁵)` (the kernel's third derivatives
+/// are at most `24 / distance⁵`). Which clusters are summed so is
+/// [`WindingOptions::accuracy`]'s choice.
 ///
 /// # Errors
 ///
@@ -211,17 +213,31 @@ pub fn signed_distances(
         .collect())
 }
 
-/// What a cluster of triangles (a node's) looks like from afar: its area, its area-weighted
-/// normal `Σ A n`, its area-weighted centroid `c`, the spread `Σ A n (cₜ − c)ᵀ` of its
-/// triangles' centroids `cₜ` about it, and the radius about `c` within which all its
-/// corners lie (model frame).
+/// What a cluster of triangles (a node's) looks like from afar (model frame): its area, its
+/// area-weighted normal `N = Σ A n`, its area-weighted centroid `c`, the moments
+/// `spread = Σ n ∫ (x − c)ᵀ dA` and `bend[i] = Σ nᵢ ∫ (x − c)(x − c)ᵀ dA` over its
+/// triangles (unit normals `n`), and the radius about `c` within which all its corners lie.
 #[derive(Clone, Copy, Debug, Default)]
 struct Moment {
     area: f64,
     normal: Vector3<f64>,
     centroid: Vector3<f64>,
     spread: Matrix3<f64>,
+    bend: [Matrix3<f64>; 3],
+    /// `Σᵢ bend[i]` row `i`, and the traces of `bend`: what the expansion reads of it.
+    bend_rows: Vector3<f64>,
+    bend_traces: Vector3<f64>,
     radius: f64,
+}
+
+impl Moment {
+    /// Fills in what the expansion reads of `bend`.
+    fn with_bend(mut self, bend: [Matrix3<f64>; 3]) -> Moment {
+        self.bend = bend;
+        self.bend_rows = (0..3).map(|i| bend[i].row(i).transpose()).sum();
+        self.bend_traces = Vector3::new(bend[0].trace(), bend[1].trace(), bend[2].trace());
+        self
+    }
 }
 
 /// Every node's moment, children before parents (children follow their parent in the
@@ -231,33 +247,10 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
     for node in (0..tree.nodes().len() as u32).rev() {
         let m = match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
             NodeKind::Faces(faces) => {
-                // Each triangle's area-weighted normal and centroid, and its corners.
-                let (mut parts, mut corners) = (Vec::new(), Vec::new());
-                for face in faces {
-                    let t = triangle(tree, face, None, Side::A)?;
-                    let n = (t[1] - t[0]).cross(&(t[2] - t[0])) / 2.0;
-                    parts.push((n, (t[0] + t[1] + t[2]) / 3.0));
-                    corners.extend(t);
-                }
-                let area = parts.iter().map(|(n, _)| n.norm()).sum::<f64>();
-                let normal = parts.iter().map(|(n, _)| n).sum();
-                let weighted = parts.iter().map(|(n, c)| c * n.norm()).sum();
-                let centroid = centre(weighted, area, corners.iter().copied());
-                let spread = parts
-                    .iter()
-                    .map(|(n, c)| n * (c - centroid).transpose())
-                    .sum();
-                let radius = corners
-                    .iter()
-                    .map(|c| (c - centroid).norm())
-                    .fold(0.0, f64::max);
-                Moment {
-                    area,
-                    normal,
-                    centroid,
-                    spread,
-                    radius,
-                }
+                let triangles = faces
+                    .map(|face| triangle(tree, face, None, Side::A))
+                    .collect::<Result<Vec<_>, _>>()?;
+                of_triangles(&triangles)
             }
             NodeKind::Children(range) => {
                 let kids = out
@@ -272,6 +265,19 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                     .iter()
                     .map(|k| k.spread + k.normal * (k.centroid - centroid).transpose())
                     .sum();
+                // And each child's bend: with δ = c_child − c,
+                // bend'ᵢ = bendᵢ + sᵢ δᵀ + δ sᵢᵀ + Nᵢ δ δᵀ (sᵢ row i of the child's spread).
+                let mut bend = [Matrix3::zeros(); 3];
+                for k in kids {
+                    let delta = k.centroid - centroid;
+                    for (i, b) in bend.iter_mut().enumerate() {
+                        let s = k.spread.row(i).transpose();
+                        *b += k.bend[i]
+                            + s * delta.transpose()
+                            + delta * s.transpose()
+                            + delta * delta.transpose() * k.normal[i];
+                    }
+                }
                 let radius = kids
                     .iter()
                     .map(|k| (k.centroid - centroid).norm() + k.radius)
@@ -282,7 +288,9 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                     centroid,
                     spread,
                     radius,
+                    ..Moment::default()
                 }
+                .with_bend(bend)
             }
         };
         if let Some(slot) = out.get_mut(node as usize) {
@@ -290,6 +298,53 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
         }
     }
     Ok(out)
+}
+
+/// The moment of a cluster of triangles, from the triangles themselves.
+fn of_triangles(triangles: &[Triangle]) -> Moment {
+    // Each triangle's area-weighted normal, centroid and corners.
+    let parts: Vec<_> = triangles
+        .iter()
+        .map(|t| {
+            (
+                (t[1] - t[0]).cross(&(t[2] - t[0])) / 2.0,
+                (t[0] + t[1] + t[2]) / 3.0,
+                t,
+            )
+        })
+        .collect();
+    let area = parts.iter().map(|(n, _, _)| n.norm()).sum::<f64>();
+    let normal = parts.iter().map(|(n, _, _)| n).sum();
+    let weighted = parts.iter().map(|(n, c, _)| c * n.norm()).sum();
+    let centroid = centre(weighted, area, triangles.iter().flatten().copied());
+    let spread = parts
+        .iter()
+        .map(|(n, c, _)| n * (c - centroid).transpose())
+        .sum();
+    // A triangle's ∫ y yᵀ dA about the centroid is A/12 (Σ vvᵀ + 9 ccᵀ) of its corners v
+    // and centroid c taken from it; n = A n̂ takes the A.
+    let mut bend = [Matrix3::zeros(); 3];
+    for (n, c, t) in &parts {
+        let square = |v: &Vector3<f64>| (v - centroid) * (v - centroid).transpose();
+        let second = (t.iter().map(square).sum::<Matrix3<f64>>() + square(c) * 9.0) / 12.0;
+        for (b, ni) in bend.iter_mut().zip(n.iter()) {
+            *b += second * *ni;
+        }
+    }
+    let radius = triangles
+        .iter()
+        .flatten()
+        .map(|c| (c - centroid).norm())
+        .fold(0.0, f64::max);
+    Moment {
+        area,
+        normal,
+        centroid,
+        spread,
+        radius,
+        ..Moment::default()
+    }
+    .with_bend(bend)
 }
 
 /// The area-weighted centroid, or for a cluster of no area the mean of `points`.
@@ -349,20 +404,28 @@ fn descend<B: BoundingVolume>(
         let offset = m.centroid - p;
         let distance = offset.norm();
         if distance > m.radius {
-            let gap = distance - m.radius;
-            let error = 3.0 * m.area * m.radius * m.radius / (4.0 * PI * gap * gap * gap * gap);
+            let (gap, r) = (distance - m.radius, m.radius);
+            let error = m.area * r * r * r / (PI * gap * gap * gap * gap * gap);
             let accept = match rule {
                 Rule::Exact => false,
                 Rule::Rate(rate) => error <= rate * m.area,
                 Rule::Beta(beta) => distance > beta * m.radius,
             };
             if accept {
-                // The kernel g(x) = (x − p) / |x − p|³ to first order about the centroid:
-                // g·N, plus the gradient's inner product with the spread.
-                let d3 = distance * distance * distance;
+                // The kernel g = ∇φ, φ(x) = −1/|x − p|, to second order about the
+                // centroid, u = c − p: ∂ᵢφ = uᵢ/d³, ∂ᵢⱼφ = δᵢⱼ/d³ − 3uᵢuⱼ/d⁵,
+                // ∂ᵢⱼₖφ = −3(δᵢⱼuₖ + δᵢₖuⱼ + δⱼₖuᵢ)/d⁵ + 15uᵢuⱼuₖ/d⁷, against N, spread
+                // and bend/2.
                 let u = offset;
+                let d2 = distance * distance;
+                let d3 = d2 * distance;
+                let (d5, d7) = (d3 * d2, d3 * d2 * d2);
+                let quadratic: f64 = (0..3).map(|i| u[i] * u.dot(&(m.bend[i] * u))).sum();
                 sum += m.normal.dot(&u) / d3 + m.spread.trace() / d3
-                    - 3.0 * u.dot(&(m.spread * u)) / (d3 * distance * distance);
+                    - 3.0 * u.dot(&(m.spread * u)) / d5
+                    + 0.5
+                        * (-3.0 * (2.0 * m.bend_rows.dot(&u) + m.bend_traces.dot(&u)) / d5
+                            + 15.0 * quadratic / d7);
                 bound += error;
                 work.bv_disjoint += 1;
                 continue;
@@ -387,4 +450,51 @@ fn descend<B: BoundingVolume>(
         error_bound: bound,
         work,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build::{build, BuildOptions};
+
+    /// Merging children's moments gives what the subtree's triangles give directly.
+    #[test]
+    fn merged_moments_equal_the_moments_of_the_triangles() {
+        let mesh = crate::generate::lat_long_sphere(1.0, 7, 9).expect("a sphere");
+        let file = build(&mesh, &BuildOptions::default(), None).expect("builds");
+        struct Check;
+        impl TreeVisitor for Check {
+            type Output = ();
+            fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) {
+                let merged = moments(&tree).expect("moments");
+                // Each node's faces: a leaf's own, else its children's.
+                let mut faces: Vec<Vec<u32>> = vec![Vec::new(); merged.len()];
+                for node in (0..merged.len() as u32).rev() {
+                    faces[node as usize] = match tree.node_kind(node).expect("a node") {
+                        NodeKind::Faces(range) => range.collect(),
+                        NodeKind::Children(range) => {
+                            range.flat_map(|c| faces[c as usize].clone()).collect()
+                        }
+                    };
+                }
+                for (node, m) in merged.iter().enumerate() {
+                    let ts: Vec<Triangle> = faces[node]
+                        .iter()
+                        .map(|&f| triangle(&tree, f, None, Side::A).expect("a triangle"))
+                        .collect();
+                    let direct = of_triangles(&ts);
+                    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
+                    assert!(close(m.area, direct.area));
+                    assert!((m.centroid - direct.centroid).norm() < 1e-12);
+                    assert!((m.normal - direct.normal).norm() < 1e-12);
+                    assert!((m.spread - direct.spread).norm() < 1e-12, "node {node}");
+                    for i in 0..3 {
+                        assert!((m.bend[i] - direct.bend[i]).norm() < 1e-12, "node {node}");
+                    }
+                    assert!(m.radius >= direct.radius - 1e-12);
+                }
+            }
+        }
+        file.visit(Check).expect("a view");
+    }
 }
