@@ -234,7 +234,11 @@ impl Moment {
     /// Fills in what the expansion reads of `bend`.
     fn with_bend(mut self, bend: [Matrix3<f64>; 3]) -> Moment {
         self.bend = bend;
-        self.bend_rows = (0..3).map(|i| bend[i].row(i).transpose()).sum();
+        self.bend_rows = bend
+            .iter()
+            .enumerate()
+            .map(|(i, b)| b.row(i).transpose())
+            .sum();
         self.bend_traces = Vector3::new(bend[0].trace(), bend[1].trace(), bend[2].trace());
         self
     }
@@ -270,12 +274,17 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                 let mut bend = [Matrix3::zeros(); 3];
                 for k in kids {
                     let delta = k.centroid - centroid;
-                    for (i, b) in bend.iter_mut().enumerate() {
+                    let rows = bend
+                        .iter_mut()
+                        .zip(&k.bend)
+                        .zip(k.normal.iter())
+                        .enumerate();
+                    for (i, ((b, kb), ni)) in rows {
                         let s = k.spread.row(i).transpose();
-                        *b += k.bend[i]
+                        *b += kb
                             + s * delta.transpose()
                             + delta * s.transpose()
-                            + delta * delta.transpose() * k.normal[i];
+                            + delta * delta.transpose() * *ni;
                     }
                 }
                 let radius = kids
@@ -420,7 +429,12 @@ fn descend<B: BoundingVolume>(
                 let d2 = distance * distance;
                 let d3 = d2 * distance;
                 let (d5, d7) = (d3 * d2, d3 * d2 * d2);
-                let quadratic: f64 = (0..3).map(|i| u[i] * u.dot(&(m.bend[i] * u))).sum();
+                let quadratic: f64 = m
+                    .bend
+                    .iter()
+                    .zip(u.iter())
+                    .map(|(b, ui)| ui * u.dot(&(b * u)))
+                    .sum();
                 sum += m.normal.dot(&u) / d3 + m.spread.trace() / d3
                     - 3.0 * u.dot(&(m.spread * u)) / d5
                     + 0.5
