@@ -4,7 +4,7 @@ use super::build::TreeArgs;
 use super::poses::ModelPoseArgs;
 use super::print::out;
 use super::query::open_model;
-use super::rows::numeric_rows;
+use super::rows::PointArgs;
 use super::{number, Failure};
 use clap::Args;
 use obbtree::query::{closest_points, ClosestOptions, ClosestResult};
@@ -24,19 +24,8 @@ use std::path::PathBuf;
 pub struct ClosestArgs {
     /// The model: a .obbt file, or a mesh (.obj, .stl) built in memory first.
     pub model: PathBuf,
-    /// One query point, world frame: x,y,z.
-    #[arg(
-        long,
-        value_name = "X,Y,Z",
-        allow_hyphen_values = true,
-        conflicts_with = "points"
-    )]
-    pub point: Option<String>,
-    /// Query points, world frame: a file (`-` for stdin) of lines `x y z` (or `x,y,z`);
-    /// blank lines and lines starting with `#` are skipped. Answered in parallel, printed
-    /// in input order, each with "point": its index from 0.
-    #[arg(long, value_name = "FILE")]
-    pub points: Option<PathBuf>,
+    #[command(flatten)]
+    pub query: PointArgs,
     #[command(flatten)]
     pub pose: ModelPoseArgs,
     /// Only surface points nearer than D count (world units, > 0).
@@ -58,13 +47,7 @@ pub struct ClosestArgs {
 
 pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
     let pose = args.pose.pose()?;
-    let points = numeric_rows::<3>(
-        args.point.as_deref(),
-        "--point X,Y,Z",
-        args.points.as_deref(),
-        "--points",
-        "x y z",
-    )?;
+    let points = args.query.rows()?;
     let model = open_model(&args.model, &args.tree)?;
     let options = ClosestOptions {
         max_distance: args.max_distance.unwrap_or(f64::INFINITY),

@@ -4,7 +4,7 @@ use super::build::TreeArgs;
 use super::poses::ModelPoseArgs;
 use super::print::out;
 use super::query::open_model;
-use super::rows::numeric_rows;
+use super::rows::PointArgs;
 use super::{number, Failure};
 use clap::Args;
 use obbtree::query::{
@@ -30,19 +30,8 @@ use std::path::PathBuf;
 pub struct InsideArgs {
     /// The model: a .obbt file, or a mesh (.obj, .stl) built in memory first.
     pub model: PathBuf,
-    /// One query point, world frame: x,y,z.
-    #[arg(
-        long,
-        value_name = "X,Y,Z",
-        allow_hyphen_values = true,
-        conflicts_with = "points"
-    )]
-    pub point: Option<String>,
-    /// Query points, world frame: a file (`-` for stdin) of lines `x y z` (or `x,y,z`);
-    /// blank lines and lines starting with `#` are skipped. Answered in parallel, printed
-    /// in input order, each with "point": its index from 0.
-    #[arg(long, value_name = "FILE")]
-    pub points: Option<PathBuf>,
+    #[command(flatten)]
+    pub query: PointArgs,
     #[command(flatten)]
     pub pose: ModelPoseArgs,
     /// Sum clusters seen from more than B times their radius by their moments (> 1).
@@ -76,13 +65,7 @@ pub struct InsideArgs {
 
 pub fn run(args: &InsideArgs) -> Result<(), Failure> {
     let pose = args.pose.pose()?;
-    let points = numeric_rows::<3>(
-        args.point.as_deref(),
-        "--point X,Y,Z",
-        args.points.as_deref(),
-        "--points",
-        "x y z",
-    )?;
+    let points = args.query.rows()?;
     let accuracy = match args.tolerance {
         Some(0.0) => WindingAccuracy::Exact,
         Some(tolerance) => WindingAccuracy::Bounded { tolerance },

@@ -3,8 +3,9 @@
 
 use super::poses::parse_numbers;
 use super::{Failure, WithContext};
+use clap::Args;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The rows of `N` numbers (named `names`, e.g. `x y z`) given by exactly one of
 /// `single` (the text of flag `single_flag`) and `file` (a path, `-` for stdin, of lines
@@ -62,5 +63,36 @@ pub fn numeric_rows<const N: usize>(
         _ => Err(Failure::msg(format!(
             "give {single_flag} or {file_flag} FILE (- for stdin)"
         ))),
+    }
+}
+
+/// The query points of a one-model query: one on the command line, or many in a file.
+#[derive(Args, Debug)]
+pub struct PointArgs {
+    /// One query point, world frame: x,y,z.
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true,
+        conflicts_with = "points"
+    )]
+    pub point: Option<String>,
+    /// Query points, world frame: a file (`-` for stdin) of lines `x y z` (or `x,y,z`);
+    /// blank lines and lines starting with `#` are skipped. Answered in parallel, printed
+    /// in input order, each with "point": its index from 0.
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+}
+
+impl PointArgs {
+    /// The points given.
+    pub fn rows(&self) -> Result<Vec<[f64; 3]>, Failure> {
+        numeric_rows::<3>(
+            self.point.as_deref(),
+            "--point X,Y,Z",
+            self.points.as_deref(),
+            "--points",
+            "x y z",
+        )
     }
 }

@@ -239,16 +239,29 @@ struct Moment {
 }
 
 impl Moment {
-    /// Fills in what the expansion reads of `bend`.
-    fn with_bend(mut self, bend: [Matrix3<f64>; 3]) -> Moment {
-        self.bend = bend;
-        self.bend_rows = bend
-            .iter()
-            .enumerate()
-            .map(|(i, b)| b.row(i).transpose())
-            .sum();
-        self.bend_traces = Vector3::new(bend[0].trace(), bend[1].trace(), bend[2].trace());
-        self
+    /// The moment of these parts, with what the expansion reads of `bend`.
+    fn new(
+        area: f64,
+        normal: Vector3<f64>,
+        centroid: Vector3<f64>,
+        spread: Matrix3<f64>,
+        bend: [Matrix3<f64>; 3],
+        radius: f64,
+    ) -> Moment {
+        Moment {
+            area,
+            normal,
+            centroid,
+            spread,
+            bend,
+            bend_rows: bend
+                .iter()
+                .enumerate()
+                .map(|(i, b)| b.row(i).transpose())
+                .sum(),
+            bend_traces: Vector3::new(bend[0].trace(), bend[1].trace(), bend[2].trace()),
+            radius,
+        }
     }
 }
 
@@ -309,15 +322,7 @@ fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, Que
                     .iter()
                     .map(|k| (k.centroid - centroid).norm() + k.radius)
                     .fold(0.0, f64::max);
-                Moment {
-                    area,
-                    normal,
-                    centroid,
-                    spread,
-                    radius,
-                    ..Moment::default()
-                }
-                .with_bend(bend)
+                Moment::new(area, normal, centroid, spread, bend, radius)
             }
         };
         if let Some(slot) = out.get_mut(node as usize) {
@@ -363,15 +368,7 @@ fn of_triangles(triangles: &[Triangle]) -> Moment {
         .flatten()
         .map(|c| (c - centroid).norm())
         .fold(0.0, f64::max);
-    Moment {
-        area,
-        normal,
-        centroid,
-        spread,
-        radius,
-        ..Moment::default()
-    }
-    .with_bend(bend)
+    Moment::new(area, normal, centroid, spread, bend, radius)
 }
 
 /// The area-weighted centroid, or for a cluster of no area the mean of `points`.

@@ -41,3 +41,14 @@ def median_seconds(run, repeat):
         result = run()
         times.append(time.perf_counter() - started)
     return float(np.median(times)), result
+
+
+def peers(makers):
+    """An instance of each peer class that imports, with a message for each that does not."""
+    out = []
+    for make in makers:
+        try:
+            out.append(make())
+        except ImportError as e:
+            print(f"skipping {make.name}: {e}", file=sys.stderr)
+    return out

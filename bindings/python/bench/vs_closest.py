@@ -32,7 +32,7 @@ import time
 import numpy as np
 
 import obbtree
-from common import median_seconds, mesh_of, meshes  # noqa: E402
+from common import median_seconds, mesh_of, meshes, peers  # noqa: E402
 
 
 def query_points(v, f, n, rng):
@@ -88,23 +88,13 @@ class Open3d:
         return self.scene.compute_distance(t).numpy().astype(np.float64)
 
 
-def peers():
-    out = []
-    for make in [Igl, Open3d]:
-        try:
-            out.append(make())
-        except ImportError as e:
-            print(f"skipping {make.name}: {e}", file=sys.stderr)
-    return out
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--points", type=int, default=100_000)
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
-    others = peers()
+    others = peers([Igl, Open3d])
     rng = np.random.default_rng(args.seed)
     disagreements = 0
     ratios = {p.name: [] for p in others}

@@ -31,7 +31,7 @@ os.environ.setdefault("RAYON_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 import obbtree  # noqa: E402
-from common import median_seconds, mesh_of, meshes  # noqa: E402
+from common import median_seconds, mesh_of, meshes, peers  # noqa: E402
 
 
 def ray_sets(v, n, rng):
@@ -94,23 +94,13 @@ class Open3d:
         return lambda: self.scene.cast_rays(rays, nthreads=1)["t_hit"].numpy().astype(np.float64)
 
 
-def peers():
-    out = []
-    for make in [Embree, Open3d]:
-        try:
-            out.append(make())
-        except ImportError as e:
-            print(f"skipping {make.name}: {e}", file=sys.stderr)
-    return out
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rays", type=int, default=100_000)
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
-    others = peers()
+    others = peers([Embree, Open3d])
     rng = np.random.default_rng(args.seed)
     ratios = {p.name: [] for p in others}
     print("| mesh | rays | triangles | obbtree µs | " + " | ".join(
