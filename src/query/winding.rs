@@ -431,12 +431,13 @@ fn descend<B: BoundingVolume>(
             let (gap, r) = (distance - near.radius, near.radius);
             // The bound on what summing by moments errs by.
             let error = || near.area * r * r * r / (PI * gap * gap * gap * gap * gap);
-            let accept = match rule {
-                Rule::Exact => false,
-                Rule::Rate(rate) => error() <= rate * near.area,
-                Rule::Beta(beta) => distance > beta * r,
+            // The bound of a cluster summed by moments, computed once and only when needed.
+            let accepted = match rule {
+                Rule::Exact => None,
+                Rule::Rate(rate) => Some(error()).filter(|e| *e <= rate * near.area),
+                Rule::Beta(beta) => (distance > beta * r).then(error),
             };
-            if accept {
+            if let Some(error) = accepted {
                 let m = moments.get(node as usize).ok_or_else(missing)?;
                 // The kernel g = ∇φ, φ(x) = −1/|x − p|, to second order about the
                 // centroid, u = c − p: ∂ᵢφ = uᵢ/d³, ∂ᵢⱼφ = δᵢⱼ/d³ − 3uᵢuⱼ/d⁵,
@@ -457,7 +458,7 @@ fn descend<B: BoundingVolume>(
                     + 0.5
                         * (-3.0 * (2.0 * m.bend_rows.dot(&u) + m.bend_traces.dot(&u)) / d5
                             + 15.0 * quadratic / d7);
-                bound += error();
+                bound += error;
                 work.bv_disjoint += 1;
                 continue;
             }
