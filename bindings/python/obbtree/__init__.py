@@ -370,8 +370,8 @@ def winding_number(
     (naming the first), ``beta`` not above 1 or a negative ``tolerance``; ``PoseError`` for a
     pose that is not a rigid motion.
     """
-    value, _bound = _winding_number(tree, pose, _point_rows(points), float(beta),
-                                    _tolerance(tolerance), orthonormalize)
+    value = _winding_number(tree, pose, _point_rows(points), float(beta),
+                            _tolerance(tolerance), orthonormalize)
     value.flags.writeable = False
     return value
 

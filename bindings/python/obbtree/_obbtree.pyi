@@ -256,7 +256,7 @@ def _winding_number(
     beta: float,
     tolerance: Optional[float],
     orthonormalize: bool,
-) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+) -> npt.NDArray[np.float64]: ...
 def _signed_distance(
     tree: Tree,
     pose: Poses,

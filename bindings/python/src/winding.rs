@@ -35,10 +35,9 @@ fn accuracy(beta: f64, tolerance: Option<f64>) -> WindingOptions {
 }
 
 /// The native half of `obbtree.winding_number` (which documents it): `points` an (N, 3)
-/// float64 array. Returns the (N,) winding numbers and their (N,) error bounds.
+/// float64 array. Returns the (N,) winding numbers.
 #[pyfunction]
 #[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize))]
-#[allow(clippy::type_complexity)]
 pub fn _winding_number<'py>(
     py: Python<'py>,
     tree: PyRef<'_, Tree>,
@@ -47,17 +46,14 @@ pub fn _winding_number<'py>(
     beta: f64,
     tolerance: Option<f64>,
     orthonormalize: bool,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
     let query = point_rows(&points)?;
     let options = accuracy(beta, tolerance);
     let answers =
         py.detach(|| winding_numbers(&file, &pose, &query, &options).map_err(Failure::from))?;
-    Ok((
-        PyArray1::from_iter(py, answers.iter().map(|w| w.value)),
-        PyArray1::from_iter(py, answers.iter().map(|w| w.error_bound)),
-    ))
+    Ok(PyArray1::from_iter(py, answers.iter().map(|w| w.value)))
 }
 
 /// The native half of `obbtree.signed_distance` (which documents it): the (N,) signed
