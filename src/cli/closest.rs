@@ -4,8 +4,8 @@ use super::build::TreeArgs;
 use super::poses::ModelPoseArgs;
 use super::print::out;
 use super::query::open_model;
-use super::rows::PointArgs;
-use super::{number, Failure};
+use super::rows::{PointArgs, ThreadArgs};
+use super::{number, with_threads, Failure};
 use clap::Args;
 use obbtree::query::{closest_points, ClosestOptions, ClosestResult};
 use serde_json::json;
@@ -28,6 +28,8 @@ pub struct ClosestArgs {
     pub query: PointArgs,
     #[command(flatten)]
     pub pose: ModelPoseArgs,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
     /// Only surface points nearer than D count (world units, > 0).
     #[arg(long, value_name = "D", allow_negative_numbers = true)]
     pub max_distance: Option<f64>,
@@ -52,7 +54,9 @@ pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
     let options = ClosestOptions {
         max_distance: args.max_distance.unwrap_or(f64::INFINITY),
     };
-    let answers = closest_points(&model, &pose, &points, &options)?;
+    let answers = with_threads(args.threads.threads, || {
+        closest_points(&model, &pose, &points, &options)
+    })??;
     if args.csv {
         out!("point,distance,x,y,z,triangle,feature,feature_index,bv_tests,tri_tests")?;
     }

@@ -4,11 +4,11 @@ use super::build::TreeArgs;
 use super::poses::ModelPoseArgs;
 use super::print::out;
 use super::query::open_model;
-use super::rows::PointArgs;
-use super::{number, Failure};
+use super::rows::{PointArgs, ThreadArgs};
+use super::{number, with_threads, Failure};
 use clap::Args;
 use obbtree::query::{
-    closest_points, winding_numbers, ClosestOptions, WindingAccuracy, WindingOptions,
+    closest_points, winding_numbers, ClosestOptions, QueryError, WindingAccuracy, WindingOptions,
 };
 use serde_json::json;
 use std::path::PathBuf;
@@ -34,6 +34,8 @@ pub struct InsideArgs {
     pub query: PointArgs,
     #[command(flatten)]
     pub pose: ModelPoseArgs,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
     /// Sum clusters seen from more than B times their radius by their moments (> 1).
     #[arg(
         long,
@@ -72,17 +74,21 @@ pub fn run(args: &InsideArgs) -> Result<(), Failure> {
         None => WindingAccuracy::Beta { beta: args.beta },
     };
     let model = open_model(&args.model, &args.tree)?;
-    let winding = winding_numbers(&model, &pose, &points, &WindingOptions { accuracy })?;
-    // The signed distance: the closest point's distance, signed by the winding number.
-    let signed: Vec<Option<f64>> = if args.distance {
-        closest_points(&model, &pose, &points, &ClosestOptions::default())?
-            .iter()
-            .zip(&winding)
-            .map(|(c, w)| Some(w.signed(c.distance())))
-            .collect()
-    } else {
-        vec![None; points.len()]
+    let answer = || -> Result<_, QueryError> {
+        let winding = winding_numbers(&model, &pose, &points, &WindingOptions { accuracy })?;
+        // The signed distance: the closest point's distance, signed by the winding number.
+        let signed: Vec<Option<f64>> = if args.distance {
+            closest_points(&model, &pose, &points, &ClosestOptions::default())?
+                .iter()
+                .zip(&winding)
+                .map(|(c, w)| Some(w.signed(c.distance())))
+                .collect()
+        } else {
+            vec![None; points.len()]
+        };
+        Ok((winding, signed))
     };
+    let (winding, signed) = with_threads(args.threads.threads, answer)??;
     if args.csv {
         let distance = if args.distance {
             ",signed_distance"

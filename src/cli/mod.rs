@@ -23,6 +23,7 @@ use clap::{Parser, Subcommand};
 use obbtree::scene::SceneError;
 use std::error::Error;
 use std::fmt::{self, Display};
+use std::num::NonZeroUsize;
 use std::process::ExitCode;
 
 /// Collision queries on triangle meshes with oriented bounding box trees.
@@ -170,14 +171,8 @@ pub fn with_threads<T: Send>(
     threads: Option<u32>,
     work: impl FnOnce() -> T + Send,
 ) -> Result<T, Failure> {
-    match threads {
-        None => Ok(work()),
-        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
-            .num_threads(n as usize)
-            .build()
-            .with_context(|| format!("--threads {n}"))?
-            .install(work)),
-    }
+    let threads = threads.and_then(|n| NonZeroUsize::new(usize::try_from(n).ok()?));
+    Ok(obbtree::query::on_threads(threads, work)?)
 }
 
 /// Bytes as a short human-readable size.

@@ -4,10 +4,10 @@ use super::build::TreeArgs;
 use super::poses::ModelPoseArgs;
 use super::print::out;
 use super::query::open_model;
-use super::rows::numeric_rows;
-use super::{number, Failure};
+use super::rows::{numeric_rows, ThreadArgs};
+use super::{number, with_threads, Failure};
 use clap::{Args, ValueEnum};
-use obbtree::query::{all_ray_hits, cast_rays, Ray, RayHit, RayMode, RayOptions, Work};
+use obbtree::query::{all_ray_hits, cast_rays, QueryError, Ray, RayHit, RayMode, RayOptions, Work};
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -41,6 +41,8 @@ pub struct RayArgs {
     pub rays: Option<PathBuf>,
     #[command(flatten)]
     pub pose: ModelPoseArgs,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
     /// Which hits: the closest, any one (stops at the first found: line of sight), or
     /// all of them by increasing t.
     #[arg(long, value_enum, default_value_t = Mode::Closest)]
@@ -92,23 +94,26 @@ pub fn run(args: &RayArgs) -> Result<(), Failure> {
     let model = open_model(&args.model, &args.tree)?;
     let t_max = args.t_max.unwrap_or(f64::INFINITY);
     // Each ray's hits (at most one unless --mode all) and work.
-    let answers: Vec<(Vec<RayHit>, Work)> = match args.mode {
-        Mode::All => all_ray_hits(&model, &pose, &rays, t_max)?
-            .into_iter()
-            .map(|r| (r.hits, r.work))
-            .collect(),
-        Mode::Closest | Mode::Any => {
-            let mode = if args.mode == Mode::Any {
-                RayMode::Any
-            } else {
-                RayMode::Closest
-            };
-            cast_rays(&model, &pose, &rays, &RayOptions { mode, t_max })?
+    let cast = || -> Result<Vec<(Vec<RayHit>, Work)>, QueryError> {
+        Ok(match args.mode {
+            Mode::All => all_ray_hits(&model, &pose, &rays, t_max)?
                 .into_iter()
-                .map(|r| (r.hit.into_iter().collect(), r.work))
-                .collect()
-        }
+                .map(|r| (r.hits, r.work))
+                .collect(),
+            Mode::Closest | Mode::Any => {
+                let mode = if args.mode == Mode::Any {
+                    RayMode::Any
+                } else {
+                    RayMode::Closest
+                };
+                cast_rays(&model, &pose, &rays, &RayOptions { mode, t_max })?
+                    .into_iter()
+                    .map(|r| (r.hit.into_iter().collect(), r.work))
+                    .collect()
+            }
+        })
     };
+    let answers = with_threads(args.threads.threads, cast)??;
     if args.csv {
         out!("ray,hit,t,x,y,z,triangle,b0,b1,b2,nx,ny,nz,bv_tests,tri_tests")?;
     }

@@ -96,3 +96,12 @@ impl PointArgs {
         )
     }
 }
+
+/// How many threads answer a one-model query's rows.
+#[derive(Args, Debug)]
+pub struct ThreadArgs {
+    /// Threads that answer the queries [default: one per core]. The answers do not depend
+    /// on it; take timings with --threads 1.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..1025))]
+    pub threads: Option<u32>,
+}

@@ -178,13 +178,47 @@ where
             )
             .collect()
     };
-    Ok(match options.threads {
-        None => parallel(),
-        Some(threads) => pool(threads.get())?.install(parallel),
+    on_threads(options.threads, parallel)
+}
+
+/// Runs `work` on the rayon pool the call is made in (`threads` `None`) or on a pool of
+/// `n` threads, made on first use and kept for later calls of the same count. The
+/// one-model queries ([`cast_rays`](super::cast_rays), [`closest_points`](super::closest_points),
+/// [`winding_numbers`](super::winding_numbers)) run on the pool they are called in: wrap
+/// them in this to choose their thread count, as [`batch`] does with
+/// [`BatchOptions::threads`].
+///
+/// # Errors
+///
+/// [`BatchError::Threads`] when a pool of that size cannot be made.
+///
+/// # Examples
+///
+/// ```
+/// use obbtree::format::ObbtFile;
+/// use obbtree::query::{closest_points, on_threads, ClosestOptions, Pose};
+/// use std::num::NonZeroUsize;
+///
+/// let cow = ObbtFile::open(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/cow.obbt"))?;
+/// let points: Vec<[f64; 3]> = (0..100).map(|i| [0.01 * f64::from(i), 0.5, 0.0]).collect();
+/// let one = NonZeroUsize::new(1);
+/// let answers = on_threads(one, || {
+///     closest_points(&cow, &Pose::identity(), &points, &ClosestOptions::default())
+/// })??;
+/// assert_eq!(answers.len(), 100);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn on_threads<T: Send>(
+    threads: Option<NonZeroUsize>,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T, BatchError> {
+    Ok(match threads {
+        None => work(),
+        Some(threads) => pool(threads.get())?.install(work),
     })
 }
 
-/// Thread pools made for [`BatchOptions::threads`], kept for later batches.
+/// Thread pools made for [`on_threads`], kept for later calls.
 static POOLS: Mutex<Vec<(usize, Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
 
 fn pool(threads: usize) -> Result<Arc<rayon::ThreadPool>, BatchError> {

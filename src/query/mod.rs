@@ -40,7 +40,7 @@ mod winding;
 mod work;
 
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
-pub use batch::{batch, BatchError, BatchOptions, PoseBatch};
+pub use batch::{batch, on_threads, BatchError, BatchOptions, PoseBatch};
 pub use closest::{closest_points, ClosestOptions, ClosestPoint, ClosestResult};
 pub use collide::{BoxTest, CollideOptions, CollideResult};
 pub use descent::DescentRule;

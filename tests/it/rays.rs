@@ -487,3 +487,54 @@ fn the_cli_answers_as_the_library() {
         assert_bad_input(&obbtree(&every), needle);
     }
 }
+
+/// `--threads` on the one-model commands picks how many threads answer, never what they
+/// answer: one thread and two print the same lines.
+#[test]
+fn the_one_model_commands_answer_alike_on_any_thread_count() {
+    use common::cli::{cow, obbtree, scratch, stderr};
+    let dir = scratch("one-model-threads");
+    let points = dir.join("points.txt");
+    let rays = dir.join("rays.txt");
+    let (mut p, mut r) = (String::new(), String::new());
+    for i in 0..60 {
+        let a = f64::from(i) * 0.31;
+        p += &format!(
+            "{} {} {}\n",
+            0.9 * a.cos(),
+            0.5 * a.sin(),
+            0.3 * (2.0 * a).sin()
+        );
+        r += &format!(
+            "{} {} 0.1 {} {} 0.02\n",
+            3.0 * a.cos(),
+            3.0 * a.sin(),
+            -a.cos(),
+            -a.sin()
+        );
+    }
+    std::fs::write(&points, p).expect("writes");
+    std::fs::write(&rays, r).expect("writes");
+    let (points, rays) = (points.to_str().expect("path"), rays.to_str().expect("path"));
+    let cow = cow();
+    let commands: [&[&str]; 3] = [
+        &["ray", &cow, "--rays", rays, "--mode", "all", "--json"],
+        &["closest", &cow, "--points", points, "--csv"],
+        &["inside", &cow, "--points", points, "--distance", "--csv"],
+    ];
+    for command in commands {
+        let printed: Vec<String> = ["1", "2"]
+            .iter()
+            .map(|threads| {
+                let o = obbtree(&[command, &["--threads", threads]].concat());
+                assert!(o.status.success(), "{command:?}: {}", stderr(&o));
+                String::from_utf8_lossy(&o.stdout).into_owned()
+            })
+            .collect();
+        assert_eq!(
+            printed[0].lines().count(),
+            if command[0] == "ray" { 60 } else { 61 }
+        );
+        assert_eq!(printed[0], printed[1], "{command:?}");
+    }
+}

@@ -20,6 +20,34 @@
 #define OBBTREE_MAX_THREADS 1024
 
 /**
+ * `obbtree_rays` mode: the hit of smallest `t`.
+ */
+#define OBBTREE_RAY_CLOSEST 0
+
+/**
+ * `obbtree_rays` mode: one hit, the first found (stops there: line of sight, shadows).
+ */
+#define OBBTREE_RAY_ANY 1
+
+/**
+ * `obbtree_winding_numbers` rule: clusters seen from more than `parameter` (> 1; 2 is
+ * libigl's default) times their radius are summed by their moments. Fast; the error is
+ * not bounded beforehand and is measured small.
+ */
+#define OBBTREE_WINDING_BETA 0
+
+/**
+ * `obbtree_winding_numbers` rule: each value proven within `parameter` (> 0) of the exact
+ * sum.
+ */
+#define OBBTREE_WINDING_BOUNDED 1
+
+/**
+ * `obbtree_winding_numbers` rule: every triangle summed exactly (`parameter` ignored).
+ */
+#define OBBTREE_WINDING_EXACT 2
+
+/**
  * What a call did: `OBBTREE_STATUS_OK`, or why it failed (then `obbtree_last_error` says
  * more).
  */
@@ -107,6 +135,24 @@ typedef enum ObbtreePrecision {
    */
   OBBTREE_PRECISION_F64 = 8,
 } ObbtreePrecision;
+
+/**
+ * Where on its triangle a closest point lies.
+ */
+typedef enum ObbtreeFeature {
+  /**
+   * Inside the triangle.
+   */
+  OBBTREE_FEATURE_FACE = 0,
+  /**
+   * On edge `feature_index`, from corner `k` to corner `(k + 1) % 3`.
+   */
+  OBBTREE_FEATURE_EDGE = 1,
+  /**
+   * At corner `feature_index`.
+   */
+  OBBTREE_FEATURE_VERTEX = 2,
+} ObbtreeFeature;
 
 /**
  * Two trees checked to be queryable together, with the traversal scratch kept between
@@ -361,6 +407,108 @@ typedef struct ObbtreeSpanResult {
    */
   struct ObbtreeWork work;
 } ObbtreeSpanResult;
+
+/**
+ * Where a ray meets a triangle. Without a hit (see the result's flag) `t` is +infinity,
+ * the vectors are NaN and the triangle is `OBBTREE_NO_TRIANGLE`.
+ */
+typedef struct ObbtreeRayHit {
+  /**
+   * The ray parameter: the hit is `origin + t * direction` (the distance for a unit
+   * direction).
+   */
+  double t;
+  /**
+   * The hit point, world frame.
+   */
+  double point[3];
+  /**
+   * Its weights on the triangle's corners, in the input mesh's corner order.
+   */
+  double barycentric[3];
+  /**
+   * The triangle's unit normal, world frame, from its corners' order (whichever side
+   * the ray came from).
+   */
+  double normal[3];
+  /**
+   * The input-mesh id of the triangle hit.
+   */
+  uint32_t triangle;
+} ObbtreeRayHit;
+
+/**
+ * The answer of `obbtree_rays` for one ray.
+ */
+typedef struct ObbtreeRayResult {
+  /**
+   * 1 when the ray meets the model at some `0 <= t <= t_max`.
+   */
+  bool hit;
+  /**
+   * The hit (the closest, or the first found).
+   */
+  struct ObbtreeRayHit closest;
+  /**
+   * Work done: D and I volumes missed and entered, S and K triangles missed and hit.
+   */
+  struct ObbtreeWork work;
+} ObbtreeRayResult;
+
+/**
+ * The answer of `obbtree_ray_all_hits` for one ray: where its hits are in the hits
+ * buffer.
+ */
+typedef struct ObbtreeRayHits {
+  /**
+   * How many hits the ray has (an even number for a ray from outside a closed model).
+   */
+  size_t hit_count;
+  /**
+   * Where they start in the hits buffer (the hits of every ray follow each other in ray
+   * order, each ray's by increasing `t`).
+   */
+  size_t hit_offset;
+  /**
+   * Work done.
+   */
+  struct ObbtreeWork work;
+} ObbtreeRayHits;
+
+/**
+ * The answer of `obbtree_closest_points` for one point. Without an answer (see `found`)
+ * the distance is +infinity, the point NaN and the triangle `OBBTREE_NO_TRIANGLE`.
+ */
+typedef struct ObbtreeClosestResult {
+  /**
+   * 0 when the model is at least `max_distance` from the point, 1 otherwise.
+   */
+  bool found;
+  /**
+   * Distance from the query point to the model's surface, world units.
+   */
+  double distance;
+  /**
+   * The closest point of the surface, world frame.
+   */
+  double point[3];
+  /**
+   * The input-mesh id of its triangle.
+   */
+  uint32_t triangle;
+  /**
+   * Where on the triangle it lies.
+   */
+  enum ObbtreeFeature feature;
+  /**
+   * The edge's or corner's number (0 to 2) in the input's corner order; 0 for a face.
+   */
+  uint32_t feature_index;
+  /**
+   * Work done: D and I volumes pruned and opened, S and K triangles tested.
+   */
+  struct ObbtreeWork work;
+} ObbtreeClosestResult;
 
 #ifdef __cplusplus
 extern "C" {
@@ -678,6 +826,136 @@ enum ObbtreeStatus obbtree_span_batch(const struct ObbtreeTree *a,
                                       size_t threads,
                                       struct ObbtreeSpanResult *results,
                                       size_t results_len);
+
+/**
+ * Casts `count` rays at `tree` posed by `pose`, in parallel: ray `i` is the points
+ * `origins[i] + t * directions[i]` for `0 <= t <= t_max` (3 doubles each, world frame;
+ * `t_max` > 0, `INFINITY` for none). `mode` is `OBBTREE_RAY_CLOSEST` (the hit of
+ * smallest `t`) or `OBBTREE_RAY_ANY` (the first hit found).
+ * `results` holds `results_len` answers, which must equal `count`; `threads` as for
+ * `obbtree_collide_batch`.
+ *
+ * Hits are watertight: a ray through an edge or corner shared by triangles hits exactly
+ * one of them. `OBBTREE_STATUS_BAD_ARGUMENT` names the first ray with a non-finite origin
+ * or a zero or non-finite direction, and refuses a `t_max` not above 0.
+ *
+ * # Safety
+ *
+ * `tree` is NULL or an open tree; `pose` NULL or 12 readable doubles; `origins` and
+ * `directions` NULL or `3 * count` readable doubles each; `results` NULL or
+ * `results_len` writable results, not overlapping the inputs.
+ */
+enum ObbtreeStatus obbtree_rays(const struct ObbtreeTree *tree,
+                                const double *pose,
+                                const double *origins,
+                                const double *directions,
+                                size_t count,
+                                double t_max,
+                                int32_t mode,
+                                size_t threads,
+                                struct ObbtreeRayResult *results,
+                                size_t results_len);
+
+/**
+ * Every hit of `count` rays at `tree` posed by `pose`, in parallel; the rays, `t_max`,
+ * `threads` and `results_len` as for `obbtree_rays`. `results[i]` says how many hits ray
+ * `i` has and where they start in `hits`, where the hits of every ray follow each other
+ * in ray order, each ray's by increasing `t` (ties by triangle id); `*hits_total` (if not
+ * NULL) gets the number of them all. Pass NULL and 0 for counts only. When `hits` is too
+ * short the call returns `OBBTREE_STATUS_BUFFER_TOO_SMALL` with every result complete and
+ * the first `capacity` hits written.
+ *
+ * # Safety
+ *
+ * As `obbtree_rays`, and `hits` NULL or `capacity` writable hits, `hits_total` NULL or
+ * writable, no output overlapping another or the inputs.
+ */
+enum ObbtreeStatus obbtree_ray_all_hits(const struct ObbtreeTree *tree,
+                                        const double *pose,
+                                        const double *origins,
+                                        const double *directions,
+                                        size_t count,
+                                        double t_max,
+                                        size_t threads,
+                                        struct ObbtreeRayHits *results,
+                                        size_t results_len,
+                                        struct ObbtreeRayHit *hits,
+                                        size_t capacity,
+                                        size_t *hits_total);
+
+/**
+ * The closest point of `tree` posed by `pose` to each of `count` points (3 doubles each,
+ * world frame), in parallel. Points at least `max_distance` (> 0, world units; `INFINITY`
+ * for none) from the model get `found = 0`, sooner. `results` holds `results_len`
+ * answers, which must equal `count`; `threads` as for `obbtree_collide_batch`.
+ * `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point.
+ *
+ * # Safety
+ *
+ * `tree` is NULL or an open tree; `pose` NULL or 12 readable doubles; `points` NULL or
+ * `3 * count` readable doubles; `results` NULL or `results_len` writable results, not
+ * overlapping the inputs.
+ */
+enum ObbtreeStatus obbtree_closest_points(const struct ObbtreeTree *tree,
+                                          const double *pose,
+                                          const double *points,
+                                          size_t count,
+                                          double max_distance,
+                                          size_t threads,
+                                          struct ObbtreeClosestResult *results,
+                                          size_t results_len);
+
+/**
+ * The generalised winding number of `tree` posed by `pose` at each of `count` points (3
+ * doubles each, world frame), in parallel: 1 inside a closed outward-facing surface, 0
+ * outside, between for surfaces with holes; a point is inside where it is above 0.5,
+ * which holds for polygon soups too. `rule` (`OBBTREE_WINDING_BETA`, `_BOUNDED` or
+ * `_EXACT`) and `parameter` say how far clusters are summed. `values` gets the winding numbers and `error_bounds` (if not NULL) a proven
+ * bound on each one's distance from the exact sum (rounding aside); each holds `len`
+ * values, which must equal `count`. `threads` as for `obbtree_collide_batch`.
+ * `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, and refuses a `beta`
+ * not above 1 or a tolerance not above 0.
+ *
+ * # Safety
+ *
+ * `tree` is NULL or an open tree; `pose` NULL or 12 readable doubles; `points` NULL or
+ * `3 * count` readable doubles; `values` NULL and `error_bounds` NULL or `len` writable
+ * doubles each, not overlapping each other or the inputs.
+ */
+enum ObbtreeStatus obbtree_winding_numbers(const struct ObbtreeTree *tree,
+                                           const double *pose,
+                                           const double *points,
+                                           size_t count,
+                                           int32_t rule,
+                                           double parameter,
+                                           size_t threads,
+                                           double *values,
+                                           double *error_bounds,
+                                           size_t len);
+
+/**
+ * The signed distance of `tree` posed by `pose` at each of `count` points (3 doubles
+ * each, world frame), in parallel: the distance to the closest surface point, negative
+ * where the winding number (computed by `rule` and `parameter` as in
+ * `obbtree_winding_numbers`) is above 0.5. `values` holds `len` doubles, which must equal
+ * `count`; `threads` as for `obbtree_collide_batch`. Refuses what
+ * `obbtree_winding_numbers` refuses.
+ *
+ * # Safety
+ *
+ * `tree` is NULL or an open tree; `pose` NULL or 12 readable doubles; `points` NULL or
+ * `3 * count` readable doubles; `values` NULL or `len` writable doubles, not overlapping
+ * the inputs.
+ */
+enum ObbtreeStatus obbtree_signed_distances(const struct ObbtreeTree *tree,
+                                            const double *pose,
+                                            const double *points,
+                                            size_t count,
+                                            int32_t rule,
+                                            double parameter,
+                                            size_t threads,
+                                            double *values,
+                                            size_t len);
 
 #ifdef __cplusplus
 }  // extern "C"

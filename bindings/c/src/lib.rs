@@ -1,7 +1,8 @@
 //! The C API of obbtree: open `.obbt` trees (memory-mapped from a path, or from bytes in
 //! memory), verify them, read what their header says, and run collision, distance,
 //! tolerance and span queries between two posed trees, one pose pair at a time through a
-//! reusable pair handle or a whole batch of poses in one parallel call.
+//! reusable pair handle or a whole batch of poses in one parallel call, and cast rays,
+//! find closest points and winding numbers of one posed tree for batches of rays or points.
 //!
 //! The header `include/obbtree.h` is generated from this file by cbindgen (see the README);
 //! a test fails when the committed header differs from what this source generates.
@@ -44,6 +45,9 @@ use std::mem::MaybeUninit;
 use std::num::NonZeroUsize;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{Arc, Mutex, TryLockError};
+
+mod model;
+pub use model::*;
 
 // ---------------------------------------------------------------------------------------
 // Types seen from C
@@ -1170,6 +1174,16 @@ struct Batch<'a> {
     options: BatchOptions,
 }
 
+/// A `threads` argument checked: 0 is `None` (the global pool, one thread per core).
+fn thread_count(threads: usize) -> Result<Option<NonZeroUsize>, Error> {
+    if threads > OBBTREE_MAX_THREADS {
+        return Err(Error::bad(format!(
+            "threads is {threads}: at most {OBBTREE_MAX_THREADS} (0 for one per core)"
+        )));
+    }
+    Ok(NonZeroUsize::new(threads))
+}
+
 /// The poses of one side of a batch, each checked; the first bad one is named.
 fn read_poses(values: &[f64], name: &str) -> Result<Vec<Pose>, Error> {
     let poses: Vec<Result<Pose, PoseError>> = values
@@ -1203,11 +1217,7 @@ impl<'a> Batch<'a> {
     ) -> Result<Batch<'a>, Error> {
         // SAFETY: NULL or open trees (the caller's contract).
         let (a, b) = unsafe { (deref(a, "a")?, deref(b, "b")?) };
-        if threads > OBBTREE_MAX_THREADS {
-            return Err(Error::bad(format!(
-                "threads is {threads}: at most {OBBTREE_MAX_THREADS} (0 for one per core)"
-            )));
-        }
+        let threads = thread_count(threads)?;
         let numbers = |count: usize, name: &str| {
             count
                 .checked_mul(12)
@@ -1226,9 +1236,7 @@ impl<'a> Batch<'a> {
             b: &b.file,
             poses_a: read_poses(values_a, "poses_a")?,
             poses_b: read_poses(values_b, "poses_b")?,
-            options: BatchOptions {
-                threads: NonZeroUsize::new(threads),
-            },
+            options: BatchOptions { threads },
         };
         let n = batch.poses()?.len();
         if results_len != n {

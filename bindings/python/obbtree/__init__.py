@@ -222,6 +222,7 @@ def closest(
     points: Any,
     max_distance: float = np.inf,
     *,
+    threads: Optional[int] = None,
     orthonormalize: bool = False,
 ) -> ClosestResult:
     """The closest point of a posed model's surface to each query point.
@@ -229,13 +230,14 @@ def closest(
     ``pose`` is one pose of ``tree`` (a (4, 4) matrix, 12 numbers or an ``(R, t)`` pair);
     ``points`` is an (N, 3) array of world points, or one point (3,). Points are answered in
     parallel with the GIL released; those farther than ``max_distance`` (world units, > 0)
-    get no answer, sooner. Returns a ``ClosestResult``.
+    get no answer, sooner. ``threads``: None for every core, or how many. Returns a
+    ``ClosestResult``.
 
     Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points or
     a ``max_distance`` not above 0, ``PoseError`` for a pose that is not a rigid motion.
     """
     distance, point, tri, feature, index = _closest(
-        tree, pose, _point_rows(points), float(max_distance), orthonormalize
+        tree, pose, _point_rows(points), float(max_distance), orthonormalize, threads
     )
     arrays = [distance, point, tri, _FEATURES[feature], index]
     for a in arrays:
@@ -292,6 +294,7 @@ def ray(
     t_max: float = np.inf,
     mode: str = "closest",
     *,
+    threads: Optional[int] = None,
     orthonormalize: bool = False,
 ) -> Union[RayResult, RayHits]:
     """Where rays meet a posed model: the closest hit, any hit, or all hits of each.
@@ -300,7 +303,8 @@ def ray(
     world points and vectors, or one (3,) row shared by every ray (a camera's origin). A
     ray's points are ``origin + t * direction`` for ``0 <= t <= t_max``. ``mode`` is
     ``"closest"`` (the hit of smallest t), ``"any"`` (one hit, the first found: line of
-    sight) or ``"all"``. Rays are cast in parallel with the GIL released. Hits are
+    sight) or ``"all"``. Rays are cast in parallel with the GIL released, on ``threads``
+    threads (None: every core). Hits are
     watertight: a ray through an edge or corner shared by triangles hits one of them.
     Returns a ``RayResult`` (closest, any) or a ``RayHits`` (all).
 
@@ -319,7 +323,7 @@ def ray(
         raise OptionError(f"origins and directions differ in length: {len(o)} and {len(d)}")
     index, t, tri, bary, normal = _ray(
         tree, pose, np.ascontiguousarray(o), np.ascontiguousarray(d), float(t_max), mode,
-        orthonormalize,
+        orthonormalize, threads,
     )
     point = o[index] + t[:, None] * d[index]
     if mode == "all":
@@ -351,6 +355,7 @@ def winding_number(
     *,
     beta: float = 2.0,
     tolerance: Optional[float] = None,
+    threads: Optional[int] = None,
     orthonormalize: bool = False,
 ) -> np.ndarray:
     """The generalised winding number of a posed model at each query point: (N,) float64.
@@ -358,7 +363,8 @@ def winding_number(
     1 inside a closed outward-facing surface, 0 outside, between for surfaces with holes;
     a point is inside where it is above 0.5, which holds for polygon soups too (holes,
     duplicate and self-intersecting triangles). ``points`` is an (N, 3) array of world
-    points or one point (3,); computed in parallel with the GIL released.
+    points or one point (3,); computed in parallel with the GIL released, on ``threads``
+    threads (None: every core).
 
     Far clusters of triangles are summed by their moments (Barill et al. 2018): by default
     those seen from more than ``beta`` times their radius (fast, as libigl's fast winding
@@ -371,7 +377,7 @@ def winding_number(
     pose that is not a rigid motion.
     """
     value = _winding_number(tree, pose, _point_rows(points), float(beta),
-                            _tolerance(tolerance), orthonormalize)
+                            _tolerance(tolerance), orthonormalize, threads)
     value.flags.writeable = False
     return value
 
@@ -383,6 +389,7 @@ def signed_distance(
     *,
     beta: float = 2.0,
     tolerance: Optional[float] = None,
+    threads: Optional[int] = None,
     orthonormalize: bool = False,
 ) -> np.ndarray:
     """The signed distance of a posed model at each query point: (N,) float64, the
@@ -393,7 +400,7 @@ def signed_distance(
     Raises as ``winding_number``.
     """
     value = _signed_distance(tree, pose, _point_rows(points), float(beta),
-                             _tolerance(tolerance), orthonormalize)
+                             _tolerance(tolerance), orthonormalize, threads)
     value.flags.writeable = False
     return value
 

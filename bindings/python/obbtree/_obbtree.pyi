@@ -227,6 +227,7 @@ def _closest(
     points: npt.NDArray[np.float64],
     max_distance: float,
     orthonormalize: bool,
+    threads: Optional[int],
 ) -> Tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
@@ -242,6 +243,7 @@ def _ray(
     t_max: float,
     mode: str,
     orthonormalize: bool,
+    threads: Optional[int],
 ) -> Tuple[
     npt.NDArray[np.int64],
     npt.NDArray[np.float64],
@@ -256,6 +258,7 @@ def _winding_number(
     beta: float,
     tolerance: Optional[float],
     orthonormalize: bool,
+    threads: Optional[int],
 ) -> npt.NDArray[np.float64]: ...
 def _signed_distance(
     tree: Tree,
@@ -264,6 +267,7 @@ def _signed_distance(
     beta: float,
     tolerance: Optional[float],
     orthonormalize: bool,
+    threads: Optional[int],
 ) -> npt.NDArray[np.float64]: ...
 def _time_rust_loop(
     a: Tree, poses_a: Poses, b: Tree, poses_b: Poses, query: str, repeat: int

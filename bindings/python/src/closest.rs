@@ -2,6 +2,7 @@
 
 use crate::errors::Failure;
 use crate::poses::single_pose;
+use crate::queries::detached;
 use crate::tree::Tree;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use obbtree::query::{closest_points, ClosestOptions};
@@ -12,7 +13,7 @@ use pyo3::prelude::*;
 /// (+inf without an answer), (N, 3) float64 (NaN), (N,) int64 (-1), (N,) int8 (0 face,
 /// 1 edge, 2 vertex, -1), (N,) int8.
 #[pyfunction]
-#[pyo3(signature = (tree, pose, points, max_distance, orthonormalize))]
+#[pyo3(signature = (tree, pose, points, max_distance, orthonormalize, threads))]
 #[allow(clippy::type_complexity)]
 pub fn _closest<'py>(
     py: Python<'py>,
@@ -21,6 +22,7 @@ pub fn _closest<'py>(
     points: PyReadonlyArray2<'py, f64>,
     max_distance: f64,
     orthonormalize: bool,
+    threads: Option<i64>,
 ) -> PyResult<(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray2<f64>>,
@@ -32,8 +34,9 @@ pub fn _closest<'py>(
     let pose = single_pose("pose", pose, orthonormalize)?;
     let query = crate::winding::point_rows(&points)?;
     let options = ClosestOptions { max_distance };
-    let answers =
-        py.detach(|| closest_points(&file, &pose, &query, &options).map_err(Failure::from))?;
+    let answers = detached(py, threads, || {
+        closest_points(&file, &pose, &query, &options).map_err(Failure::from)
+    })?;
     let n = answers.len();
     let (mut distance, mut point, mut tri, mut feature, mut index) = (
         Vec::with_capacity(n),

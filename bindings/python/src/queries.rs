@@ -10,8 +10,8 @@ use crate::tree::Tree;
 use numpy::{PyArray1, PyArrayMethods};
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    batch, BatchOptions, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, PoseBatch,
-    QueryError, SpanOptions, ToleranceOptions, Witness, Work,
+    batch, on_threads, BatchOptions, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose,
+    PoseBatch, QueryError, SpanOptions, ToleranceOptions, Witness, Work,
 };
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -45,6 +45,20 @@ fn threads_arg(threads: Option<i64>) -> Result<Option<usize>, Failure> {
             format!("threads must be None or 1 to 1024, got {n}"),
         )),
     }
+}
+
+/// Runs `work` with the GIL released on `threads` threads (`threads=` as the caller gave
+/// it: `None` for every core): how the one-model queries run.
+pub fn detached<T: Send>(
+    py: Python<'_>,
+    threads: Option<i64>,
+    work: impl FnOnce() -> Result<T, Failure> + Send,
+) -> PyResult<T> {
+    let threads = threads_arg(threads)?.and_then(NonZeroUsize::new);
+    let answer = py
+        .detach(|| on_threads(threads, work))
+        .map_err(Failure::from)?;
+    Ok(answer?)
 }
 
 /// Everything a batch needs, owned, so that it runs without the GIL.

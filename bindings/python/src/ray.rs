@@ -2,6 +2,7 @@
 
 use crate::errors::{Failure, Kind};
 use crate::poses::single_pose;
+use crate::queries::detached;
 use crate::tree::Tree;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2};
 use obbtree::query::{all_ray_hits, cast_rays, Ray, RayHit, RayMode, RayOptions};
@@ -13,7 +14,7 @@ use pyo3::prelude::*;
 /// float64, (M,) int64, (M, 3) float64, (M, 3) float64 arrays, where M is the number of
 /// hits (at most one per ray unless `mode` is `all`).
 #[pyfunction]
-#[pyo3(signature = (tree, pose, origins, directions, t_max, mode, orthonormalize))]
+#[pyo3(signature = (tree, pose, origins, directions, t_max, mode, orthonormalize, threads))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn _ray<'py>(
     py: Python<'py>,
@@ -24,6 +25,7 @@ pub fn _ray<'py>(
     t_max: f64,
     mode: &str,
     orthonormalize: bool,
+    threads: Option<i64>,
 ) -> PyResult<(
     Bound<'py, PyArray1<i64>>,
     Bound<'py, PyArray1<f64>>,
@@ -67,7 +69,7 @@ pub fn _ray<'py>(
         }
     };
     // Each ray's hits, in ray order.
-    let hits: Vec<Vec<RayHit>> = py.detach(|| -> Result<_, Failure> {
+    let hits: Vec<Vec<RayHit>> = detached(py, threads, || -> Result<_, Failure> {
         Ok(match mode {
             Some(mode) => cast_rays(&file, &pose, &rays, &RayOptions { mode, t_max })?
                 .into_iter()

@@ -2,6 +2,7 @@
 
 use crate::errors::{Failure, Kind};
 use crate::poses::single_pose;
+use crate::queries::detached;
 use crate::tree::Tree;
 use numpy::{PyArray1, PyReadonlyArray2};
 use obbtree::query::{signed_distances, winding_numbers, WindingAccuracy, WindingOptions};
@@ -37,7 +38,8 @@ fn accuracy(beta: f64, tolerance: Option<f64>) -> WindingOptions {
 /// The native half of `obbtree.winding_number` (which documents it): `points` an (N, 3)
 /// float64 array. Returns the (N,) winding numbers.
 #[pyfunction]
-#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize))]
+#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize, threads))]
+#[allow(clippy::too_many_arguments)]
 pub fn _winding_number<'py>(
     py: Python<'py>,
     tree: PyRef<'_, Tree>,
@@ -46,20 +48,23 @@ pub fn _winding_number<'py>(
     beta: f64,
     tolerance: Option<f64>,
     orthonormalize: bool,
+    threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
     let query = point_rows(&points)?;
     let options = accuracy(beta, tolerance);
-    let answers =
-        py.detach(|| winding_numbers(&file, &pose, &query, &options).map_err(Failure::from))?;
+    let answers = detached(py, threads, || {
+        winding_numbers(&file, &pose, &query, &options).map_err(Failure::from)
+    })?;
     Ok(PyArray1::from_iter(py, answers.iter().map(|w| w.value)))
 }
 
 /// The native half of `obbtree.signed_distance` (which documents it): the (N,) signed
 /// distances at an (N, 3) float64 array of points.
 #[pyfunction]
-#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize))]
+#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize, threads))]
+#[allow(clippy::too_many_arguments)]
 pub fn _signed_distance<'py>(
     py: Python<'py>,
     tree: PyRef<'_, Tree>,
@@ -68,12 +73,14 @@ pub fn _signed_distance<'py>(
     beta: f64,
     tolerance: Option<f64>,
     orthonormalize: bool,
+    threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
     let query = point_rows(&points)?;
     let options = accuracy(beta, tolerance);
-    let answers =
-        py.detach(|| signed_distances(&file, &pose, &query, &options).map_err(Failure::from))?;
+    let answers = detached(py, threads, || {
+        signed_distances(&file, &pose, &query, &options).map_err(Failure::from)
+    })?;
     Ok(PyArray1::from_vec(py, answers))
 }

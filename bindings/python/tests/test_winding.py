@@ -66,3 +66,28 @@ def test_bad_input_raises(cow):
         obbtree.signed_distance(cow, np.eye(4), [0, 0, 0], tolerance=-1)
     with pytest.raises(obbtree.PoseError):
         obbtree.signed_distance(cow, np.eye(4) * 2, [0, 0, 0])
+
+
+def test_thread_counts_do_not_change_the_answers(cow):
+    rng = np.random.default_rng(7)
+    lo, hi = cow.vertices.min(axis=0), cow.vertices.max(axis=0)
+    points = rng.uniform(lo, hi, size=(300, 3))
+    origins, directions = points, rng.normal(size=(300, 3))
+    answers = []
+    for threads in (None, 1, 2):
+        answers.append([
+            obbtree.winding_number(cow, np.eye(4), points, threads=threads),
+            obbtree.signed_distance(cow, np.eye(4), points, threads=threads),
+            obbtree.closest(cow, np.eye(4), points, threads=threads).distance,
+            obbtree.ray(cow, np.eye(4), origins, directions, threads=threads).t,
+        ])
+    for other in answers[1:]:
+        for a, b in zip(answers[0], other):
+            np.testing.assert_array_equal(a, b)
+    for call in (
+        lambda: obbtree.winding_number(cow, np.eye(4), points, threads=0),
+        lambda: obbtree.closest(cow, np.eye(4), points, threads=-1),
+        lambda: obbtree.ray(cow, np.eye(4), origins, directions, threads=2000),
+    ):
+        with pytest.raises(obbtree.OptionError, match="threads"):
+            call()
