@@ -63,6 +63,12 @@ impl ClosestResult {
 /// The closest point of `model`, posed by `pose` (model frame to world), to each of
 /// `points` (world frame), computed in parallel.
 ///
+/// Each point's search starts from the triangle found for the point before it (within
+/// fixed runs of points, so that the answers do not depend on the thread count): give
+/// coherent points (a scan line, a sweep, a sorted cloud) in order and they cost less.
+/// Where two triangles are equally near, which one is named may depend on that order; the
+/// distance does not.
+///
 /// # Errors
 ///
 /// - [`QueryError::BadInput`] for a query point with a non-finite coordinate,
@@ -110,23 +116,34 @@ pub fn closest_points(
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
-            // One heap per worker, reused point after point.
-            self.points
-                .par_iter()
-                .map_init(BinaryHeap::new, |heap, p| {
-                    let local = to_model.apply(&Vector3::from(*p));
-                    let found = descend(&tree, &local, self.options.max_distance, heap)?;
-                    Ok(ClosestResult {
-                        closest: found.best.map(|(face, point, feature)| ClosestPoint {
-                            distance: found.distance,
-                            point: self.pose.apply(&point).into(),
-                            triangle: face,
-                            feature,
-                        }),
-                        work: found.work,
-                    })
+            // Runs of points in input order, each point's descent seeded with the triangle
+            // its predecessor in the run found: fixed runs keep the answers independent of
+            // the thread count. One heap per worker, reused point after point.
+            let runs: Vec<Vec<ClosestResult>> = self
+                .points
+                .par_chunks(WARM_RUN)
+                .map_init(BinaryHeap::new, |heap, run| {
+                    let mut seed = None;
+                    run.iter()
+                        .map(|p| {
+                            let local = to_model.apply(&Vector3::from(*p));
+                            let found =
+                                descend(&tree, &local, self.options.max_distance, seed, heap)?;
+                            seed = found.best.as_ref().map(|best| best.face);
+                            Ok(ClosestResult {
+                                closest: found.best.map(|best| ClosestPoint {
+                                    distance: found.distance,
+                                    point: self.pose.apply(&best.point).into(),
+                                    triangle: best.id,
+                                    feature: best.feature,
+                                }),
+                                work: found.work,
+                            })
+                        })
+                        .collect()
                 })
-                .collect()
+                .collect::<Result<_, QueryError>>()?;
+            Ok(runs.into_iter().flatten().collect())
         }
     }
     model.visit(Visit {
@@ -157,12 +174,54 @@ impl Ord for Waiting {
     }
 }
 
-/// What one descent found: the best triangle (input id), its point (model frame) and
-/// feature, its distance, and the work.
+/// Points per run of [`closest_points`]: each point's descent starts from the answer of
+/// the point before it in its run. Long enough that the seeding pays, short enough for
+/// every thread to get runs of a large batch.
+const WARM_RUN: usize = 256;
+
+/// The best triangle of a descent: its face in the tree, its input id, the closest point
+/// (model frame) and its feature.
+struct Best {
+    face: u32,
+    id: u32,
+    point: Vector3<f64>,
+    feature: Feature,
+}
+
+/// What one descent found: the best triangle, its distance, and the work.
 struct Found {
-    best: Option<(u32, Vector3<f64>, Feature)>,
+    best: Option<Best>,
     distance: f64,
     work: Work,
+}
+
+impl Found {
+    /// Tests `face` against `p`, keeping it when nearer than the best so far.
+    fn offer<B: BoundingVolume>(
+        &mut self,
+        tree: &TreeView<'_, B>,
+        p: &Vector3<f64>,
+        face: u32,
+    ) -> Result<(), QueryError> {
+        let t = triangle(tree, face, None, Side::A)?;
+        let (q, feature) = closest_point_on_triangle(p, &t);
+        let d = (p - q).norm();
+        if d == 0.0 {
+            self.work.tri_contact += 1;
+        } else {
+            self.work.tri_separated += 1;
+        }
+        if d < self.distance {
+            self.distance = d;
+            self.best = Some(Best {
+                face,
+                id: source_id(tree, face, Side::A)?,
+                point: q,
+                feature,
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Dives and a heap, as the pair distance traversal does: each expansion continues with
@@ -171,11 +230,13 @@ struct Found {
 /// the descent ends when that node's bound reaches the best distance found (every other
 /// waiting is at least as far). (Best first alone expanded the many boxes that all bound
 /// a point near the surface at 0 level by level before reaching any leaf; depth first
-/// alone opened half again as many boxes on the bunny.)
+/// alone opened half again as many boxes on the bunny.) A `seed` face, tested first,
+/// prunes from the start: for coherent points, the previous point's answer.
 fn descend<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     p: &Vector3<f64>,
     max_distance: f64,
+    seed: Option<u32>,
     heap: &mut BinaryHeap<Waiting>,
 ) -> Result<Found, QueryError> {
     let mut found = Found {
@@ -183,6 +244,9 @@ fn descend<B: BoundingVolume>(
         distance: max_distance,
         work: Work::default(),
     };
+    if let Some(face) = seed {
+        found.offer(tree, p, face)?;
+    }
     let point = [p.x, p.y, p.z];
     let root = tree
         .node(0)
@@ -202,19 +266,9 @@ fn descend<B: BoundingVolume>(
         found.work.bv_overlap += 1;
         match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
             NodeKind::Faces(faces) => {
-                for face in faces {
-                    let t = triangle(tree, face, None, Side::A)?;
-                    let (q, feature) = closest_point_on_triangle(p, &t);
-                    let d = (p - q).norm();
-                    if d == 0.0 {
-                        found.work.tri_contact += 1;
-                    } else {
-                        found.work.tri_separated += 1;
-                    }
-                    if d < found.distance {
-                        found.distance = d;
-                        found.best = Some((source_id(tree, face, Side::A)?, q, feature));
-                    }
+                // (The seed was tested first.)
+                for face in faces.filter(|&face| Some(face) != seed) {
+                    found.offer(tree, p, face)?;
                 }
             }
             // Children come after their parent (checked by `node_kind`): the descent

@@ -264,3 +264,37 @@ fn the_cli_answers_as_the_library() {
         assert_bad_input(&obbtree(&all), needle);
     }
 }
+
+/// Coherent points (a sweep along the surface) are warm-started from the answer before
+/// them: the same distances as each point asked alone, with fewer volumes and triangles
+/// tested in all.
+#[test]
+fn a_coherent_sweep_is_warm_started_from_the_previous_answer() {
+    let file = build(&common::cow(), &Default::default(), None).expect("builds");
+    let pose = Pose::identity();
+    let sweep: Vec<[f64; 3]> = (0..2000)
+        .map(|i| {
+            let a = f64::from(i) * 0.002;
+            [
+                0.9 * a.cos() - 0.2,
+                0.25 * a.sin() + 0.1,
+                0.3 * (a * 1.3).cos(),
+            ]
+        })
+        .collect();
+    let options = ClosestOptions::default();
+    let warm = closest_points(&file, &pose, &sweep, &options).expect("answers");
+    let (mut alone_bv, mut alone_tri) = (0, 0);
+    for (p, w) in sweep.iter().zip(&warm) {
+        let alone = closest_points(&file, &pose, &[*p], &options).expect("answers");
+        assert_eq!(alone[0].distance(), w.distance(), "{p:?}");
+        alone_bv += alone[0].work.bv_tests();
+        alone_tri += alone[0].work.tri_tests();
+    }
+    let warm_bv: u64 = warm.iter().map(|w| w.work.bv_tests()).sum();
+    let warm_tri: u64 = warm.iter().map(|w| w.work.tri_tests()).sum();
+    assert!(
+        warm_bv < alone_bv && warm_tri < alone_tri,
+        "warm {warm_bv} volumes, {warm_tri} triangles; alone {alone_bv}, {alone_tri}"
+    );
+}
