@@ -1,4 +1,4 @@
-//! `obbtree collide | distance | span`: queries between two posed models.
+//! `obbtree collide | distance | span | hausdorff`: queries between two posed models.
 
 use super::build::{build_with_progress, load_mesh, TreeArgs};
 use super::files::is_obbt;
@@ -10,8 +10,8 @@ use obbtree::build::BuildOptions;
 use obbtree::experiment::median_time;
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    BatchOptions, BoxTest, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose,
-    PoseBatch, SpanOptions, ToleranceOptions, Witness, Work,
+    BatchOptions, BoxTest, CollideOptions, DescentRule, DistanceOptions, HausdorffDirection,
+    HausdorffOptions, PairQuery, Pose, PoseBatch, SpanOptions, ToleranceOptions, Witness, Work,
 };
 use serde_json::{json, Value};
 use std::num::NonZeroUsize;
@@ -155,6 +155,41 @@ pub struct DistanceArgs {
 pub struct SpanArgs {
     #[command(flatten)]
     pub inputs: QueryInputs,
+}
+
+/// Compute the Hausdorff distance: how far a point of A's surface can be from B's (with
+/// --symmetric, the larger of that and the reverse), and where.
+///
+/// Prints the distance, the witness point and its closest point on the other model (world
+/// frame) with their triangles, and the proven upper bound: the true distance lies between
+/// the two. Exact to f64 rounding unless --rel-err or --abs-err allow more.
+///
+/// Example: obbtree hausdorff scan.obj part.obbt --symmetric --json
+///
+/// Example: obbtree hausdorff simplified.obbt original.obbt --rel-err 0.001
+#[derive(Args, Debug)]
+pub struct HausdorffArgs {
+    #[command(flatten)]
+    pub inputs: QueryInputs,
+    /// Relative error allowed: the answer h and the true h* satisfy h <= h* <= h (1 + E).
+    #[arg(
+        long,
+        value_name = "E",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub rel_err: f64,
+    /// Absolute error allowed (world units), as --rel-err (the larger of the two applies).
+    #[arg(
+        long,
+        value_name = "E",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub abs_err: f64,
+    /// Also measure from B to A and answer the larger: the symmetric Hausdorff distance.
+    #[arg(long)]
+    pub symmetric: bool,
 }
 
 /// Whether an input is to be read as a tree: it starts with the `.obbt` signature, or it
@@ -495,6 +530,54 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
             w.tri_b,
             w.point_b.as_slice(),
             work_text(&r.work)
+        );
+        Ok((value, text))
+    })
+}
+
+pub fn hausdorff(args: &HausdorffArgs) -> Result<(), Failure> {
+    let (a, b) = open_pair(&args.inputs)?;
+    let options = HausdorffOptions {
+        rel_err: args.rel_err,
+        abs_err: args.abs_err,
+        symmetric: args.symmetric,
+    };
+    let columns = csv_columns(&[
+        "/hausdorff",
+        "/upper_bound",
+        "/direction",
+        "/tri_a",
+        "/tri_b",
+    ]);
+    let repeat = args.inputs.repeat;
+    run_query(&args.inputs, (&a, &b), &columns, |pa, pb, _| {
+        let (h, seconds) = median_time(repeat, || {
+            obbtree::query::hausdorff(&a, pa, &b, pb, &options)
+        })?;
+        let (direction, witness) = match h.direction {
+            HausdorffDirection::AToB => ("a_to_b", "on A"),
+            HausdorffDirection::BToA => ("b_to_a", "on B"),
+        };
+        let value = json!({
+            "hausdorff": h.distance,
+            "upper_bound": h.upper_bound,
+            "direction": direction,
+            "point_a": h.point_a,
+            "point_b": h.point_b,
+            "tri_a": h.tri_a,
+            "tri_b": h.tri_b,
+            "stats": work_json(&h.work),
+            "seconds": seconds,
+        });
+        let text = format!(
+            "hausdorff: {} (at most {}) from {:?} on A (triangle {}) to {:?} on B (triangle {}), the witness {witness} ({}) in {seconds:.6} s",
+            number(h.distance),
+            number(h.upper_bound),
+            h.point_a,
+            h.tri_a,
+            h.point_b,
+            h.tri_b,
+            work_text(&h.work)
         );
         Ok((value, text))
     })

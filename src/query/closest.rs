@@ -155,7 +155,7 @@ pub fn closest_points(
 
 /// A node waiting, by its lower bound (smallest first in a max-heap).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Waiting {
+pub(super) struct Waiting {
     bound: f64,
     node: u32,
 }
@@ -177,22 +177,22 @@ impl Ord for Waiting {
 /// Points per run of [`closest_points`]: each point's descent starts from the answer of
 /// the point before it in its run. Long enough that the seeding pays, short enough for
 /// every thread to get runs of a large batch.
-const WARM_RUN: usize = 256;
+pub(super) const WARM_RUN: usize = 256;
 
 /// The best triangle of a descent: its face in the tree, its input id, the closest point
 /// (model frame) and its feature.
-struct Best {
-    face: u32,
-    id: u32,
-    point: Vector3<f64>,
-    feature: Feature,
+pub(super) struct Best {
+    pub(super) face: u32,
+    pub(super) id: u32,
+    pub(super) point: Vector3<f64>,
+    pub(super) feature: Feature,
 }
 
 /// What one descent found: the best triangle, its distance, and the work.
-struct Found {
-    best: Option<Best>,
-    distance: f64,
-    work: Work,
+pub(super) struct Found {
+    pub(super) best: Option<Best>,
+    pub(super) distance: f64,
+    pub(super) work: Work,
 }
 
 impl Found {
@@ -232,7 +232,7 @@ impl Found {
 /// a point near the surface at 0 level by level before reaching any leaf; depth first
 /// alone opened half again as many boxes on the bunny.) A `seed` face, tested first,
 /// prunes from the start: for coherent points, the previous point's answer.
-fn descend<B: BoundingVolume>(
+pub(super) fn descend<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     p: &Vector3<f64>,
     max_distance: f64,

@@ -32,6 +32,7 @@ mod descent;
 pub mod details;
 mod distance;
 mod engine;
+mod hausdorff;
 mod pair_query;
 mod ray;
 mod span;
@@ -48,6 +49,7 @@ pub use distance::{
     DistanceOptions, DistanceResult, ToleranceOptions, ToleranceResult, WarmStart, Witness,
 };
 pub use engine::QueryContext;
+pub use hausdorff::{hausdorff, HausdorffDirection, HausdorffOptions, HausdorffResult};
 pub use pair_query::PairQuery;
 pub use ray::{all_ray_hits, cast_rays, Ray, RayHit, RayHits, RayMode, RayOptions, RayResult};
 pub use span::{SpanOptions, SpanResult};

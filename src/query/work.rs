@@ -41,3 +41,14 @@ impl Work {
             + 2 * i128::from(self.tri_contact)
     }
 }
+
+/// Work summed: what several searches did together.
+impl std::ops::AddAssign for Work {
+    fn add_assign(&mut self, other: Work) {
+        self.bv_disjoint += other.bv_disjoint;
+        self.bv_overlap += other.bv_overlap;
+        self.tri_separated += other.tri_separated;
+        self.tri_contact += other.tri_contact;
+        self.nodes_visited += other.nodes_visited;
+    }
+}

@@ -15,7 +15,7 @@ use obbtree::query::{closest_points, ClosestOptions, Pose, QueryError};
 /// Distance from `p` to triangle `t`, computed another way than the library's: the
 /// projection on the plane when it falls inside (edge signs), else the nearest of the
 /// three segments.
-fn point_triangle_distance(p: &Vector3<f64>, t: &[[f64; 3]; 3]) -> f64 {
+pub(crate) fn point_triangle_distance(p: &Vector3<f64>, t: &[[f64; 3]; 3]) -> f64 {
     let [a, b, c] = t.map(Vector3::from);
     let segment = |s: Vector3<f64>, e: Vector3<f64>| {
         let d = e - s;

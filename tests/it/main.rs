@@ -22,6 +22,7 @@ mod far_apart;
 mod fit;
 mod fuzz_corpus;
 mod hard_cases;
+mod hausdorff;
 mod hostile_cli;
 mod hostile_files;
 mod layouts;

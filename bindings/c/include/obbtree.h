@@ -409,6 +409,46 @@ typedef struct ObbtreeSpanResult {
 } ObbtreeSpanResult;
 
 /**
+ * The answer of `obbtree_hausdorff`.
+ */
+typedef struct ObbtreeHausdorffResult {
+  /**
+   * The Hausdorff distance found (world units): the distance from the witness to the
+   * other model; the true distance is at least this.
+   */
+  double distance;
+  /**
+   * A proven bound the true distance does not exceed (rounding aside).
+   */
+  double upper_bound;
+  /**
+   * 0 when the witness is `point_a` (h(A, B)), 1 when it is `point_b` (h(B, A), only
+   * with `symmetric`).
+   */
+  bool b_to_a;
+  /**
+   * The point on A, world frame.
+   */
+  double point_a[3];
+  /**
+   * The point on B, world frame.
+   */
+  double point_b[3];
+  /**
+   * Input-mesh id of A's triangle holding `point_a`.
+   */
+  uint32_t tri_a;
+  /**
+   * Input-mesh id of B's triangle holding `point_b`.
+   */
+  uint32_t tri_b;
+  /**
+   * Work done.
+   */
+  struct ObbtreeWork work;
+} ObbtreeHausdorffResult;
+
+/**
  * Where a ray meets a triangle. Without a hit (see the result's flag) `t` is +infinity,
  * the vectors are NaN and the triangle is `OBBTREE_NO_TRIANGLE`.
  */
@@ -826,6 +866,29 @@ enum ObbtreeStatus obbtree_span_batch(const struct ObbtreeTree *a,
                                       size_t threads,
                                       struct ObbtreeSpanResult *results,
                                       size_t results_len);
+
+/**
+ * The Hausdorff distance from A at `pose_a` to B at `pose_b`: the largest distance from a
+ * point of A's surface to B's, with that point (the witness) and its closest point on B;
+ * with `symmetric`, the larger of that and the reverse. The answer `h` and the true `h*`
+ * satisfy `h <= h* <= max(h (1 + rel_err), h + abs_err)`; with both 0, exact to f64
+ * rounding except where the farthest point lies where two triangles of B are equally
+ * near (`upper_bound` says how close). The trees may be of any volume types and
+ * precisions. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error.
+ *
+ * # Safety
+ *
+ * `a`, `b` are NULL or open trees; `pose_a`, `pose_b` are NULL or point at 12 readable
+ * doubles; `out` is NULL or points at a writable result.
+ */
+enum ObbtreeStatus obbtree_hausdorff(const struct ObbtreeTree *a,
+                                     const double *pose_a,
+                                     const struct ObbtreeTree *b,
+                                     const double *pose_b,
+                                     double rel_err,
+                                     double abs_err,
+                                     bool symmetric,
+                                     struct ObbtreeHausdorffResult *out);
 
 /**
  * Casts `count` rays at `tree` posed by `pose`, in parallel: ray `i` is the points

@@ -46,7 +46,9 @@ use std::num::NonZeroUsize;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{Arc, Mutex, TryLockError};
 
+mod hausdorff;
 mod model;
+pub use hausdorff::*;
 pub use model::*;
 
 // ---------------------------------------------------------------------------------------

@@ -494,3 +494,71 @@ fn bad_arguments_are_refused_with_their_code_and_message() {
     };
     fails(status, ObbtreeStatus::NullPointer, "origins is NULL");
 }
+
+#[test]
+fn hausdorff_equals_the_rust_answer() {
+    let cow = Cow::new("model-hausdorff");
+    let options = obbtree::query::HausdorffOptions {
+        symmetric: true,
+        ..Default::default()
+    };
+    let want =
+        obbtree::query::hausdorff(&cow.file, &Pose::identity(), &cow.file, &cow.pose, &options)
+            .expect("answers");
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    let mut out = std::mem::MaybeUninit::<ObbtreeHausdorffResult>::uninit();
+    // SAFETY: open trees, 12 doubles each, a writable result.
+    ok(unsafe {
+        obbtree_hausdorff(
+            cow.tree,
+            identity.as_ptr(),
+            cow.tree,
+            POSE.as_ptr(),
+            0.0,
+            0.0,
+            true,
+            out.as_mut_ptr(),
+        )
+    });
+    // SAFETY: written by the successful call.
+    let got = unsafe { out.assume_init() };
+    assert_eq!(
+        (got.distance, got.upper_bound),
+        (want.distance, want.upper_bound)
+    );
+    assert_eq!((got.point_a, got.point_b), (want.point_a, want.point_b));
+    assert_eq!((got.tri_a, got.tri_b), (want.tri_a, want.tri_b));
+    assert!(got.distance > 0.1, "{}", got.distance);
+    // SAFETY: as above.
+    let status = unsafe {
+        obbtree_hausdorff(
+            cow.tree,
+            identity.as_ptr(),
+            cow.tree,
+            POSE.as_ptr(),
+            -1.0,
+            0.0,
+            false,
+            out.as_mut_ptr(),
+        )
+    };
+    fails(
+        status,
+        ObbtreeStatus::BadArgument,
+        "rel_err must be finite and at least 0",
+    );
+    // SAFETY: a NULL second tree is refused before anything is read.
+    let status = unsafe {
+        obbtree_hausdorff(
+            cow.tree,
+            identity.as_ptr(),
+            null(),
+            POSE.as_ptr(),
+            0.0,
+            0.0,
+            false,
+            out.as_mut_ptr(),
+        )
+    };
+    fails(status, ObbtreeStatus::NullPointer, "b is NULL");
+}

@@ -19,9 +19,9 @@ answers all of them in one call, in parallel, with the GIL released::
 A pose is a (4, 4) rigid matrix, 12 numbers (rotation row-major, then translation) or an
 ``(R, t)`` pair; a batch is (N, 4, 4) or (N, 12). A world point is ``R @ p + t``.
 
-Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``, and
-``closest``, ``ray``, ``winding_number`` and ``signed_distance`` (one model against
-many points or rays); classes ``Tree``, ``Scene`` and the result
+Functions: ``build``, ``open``, ``collide``, ``distance``, ``within``, ``span``,
+``hausdorff``, and ``closest``, ``ray``, ``winding_number`` and ``signed_distance`` (one
+model against many points or rays); classes ``Tree``, ``Scene`` and the result
 classes; exceptions ``Error`` and its subclasses
 ``MeshError``, ``FormatError``, ``PoseError``, ``SceneError``, ``OptionError``,
 ``FileError``.
@@ -41,6 +41,7 @@ from ._obbtree import (
     Error,
     FileError,
     FormatError,
+    HausdorffResult,
     MeshError,
     OptionError,
     PoseError,
@@ -57,6 +58,7 @@ from ._obbtree import (
     _winding_number,
     collide,
     distance,
+    hausdorff,
     open,
     span,
     within,
@@ -69,6 +71,7 @@ __all__ = [
     "distance",
     "within",
     "span",
+    "hausdorff",
     "closest",
     "ClosestResult",
     "ray",
@@ -82,6 +85,7 @@ __all__ = [
     "DistanceResult",
     "WithinResult",
     "SpanResult",
+    "HausdorffResult",
     "Error",
     "MeshError",
     "FormatError",

@@ -122,6 +122,19 @@ class SpanResult(_Witnesses):
     def span(self) -> npt.NDArray[np.float64]:
         """(N,) the largest distance between a point of A and a point of B."""
 
+class HausdorffResult(_Witnesses):
+    """The answers of hausdorff for N pose pairs."""
+
+    @property
+    def distance(self) -> npt.NDArray[np.float64]:
+        """(N,) the Hausdorff distance found: the witness's distance to the other model."""
+    @property
+    def upper_bound(self) -> npt.NDArray[np.float64]:
+        """(N,) a proven bound the true distance does not exceed."""
+    @property
+    def direction(self) -> npt.NDArray[np.str_]:
+        """(N,) "a_to_b" (the witness is point_a) or "b_to_a" (it is point_b)."""
+
 class Scene:
     """A scene file's objects and rules, stepped frame by frame."""
 
@@ -201,6 +214,20 @@ def span(
     rule: str = "diameter",
 ) -> SpanResult:
     """The span (largest distance between the models) for each pose pair."""
+
+def hausdorff(
+    a: Tree,
+    poses_a: Poses,
+    b: Tree,
+    poses_b: Poses,
+    *,
+    rel_err: float = 0.0,
+    abs_err: float = 0.0,
+    symmetric: bool = False,
+    threads: Optional[int] = None,
+    orthonormalize: bool = False,
+) -> HausdorffResult:
+    """The Hausdorff distance from A to B (or the symmetric one) for each pose pair."""
 
 def _build(
     mesh_path: Optional[str],

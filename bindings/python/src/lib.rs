@@ -131,6 +131,7 @@ fn _obbtree(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<queries::DistanceResult>()?;
     m.add_class::<queries::WithinResult>()?;
     m.add_class::<queries::SpanResult>()?;
+    m.add_class::<queries::HausdorffResult>()?;
     m.add_class::<scene::Scene>()?;
     m.add_function(wrap_pyfunction!(tree::open, m)?)?;
     m.add_function(wrap_pyfunction!(tree::_from_bytes, m)?)?;
@@ -139,6 +140,7 @@ fn _obbtree(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::distance, m)?)?;
     m.add_function(wrap_pyfunction!(queries::within, m)?)?;
     m.add_function(wrap_pyfunction!(queries::span, m)?)?;
+    m.add_function(wrap_pyfunction!(queries::hausdorff, m)?)?;
     m.add_function(wrap_pyfunction!(closest::_closest, m)?)?;
     m.add_function(wrap_pyfunction!(ray::_ray, m)?)?;
     m.add_function(wrap_pyfunction!(winding::_winding_number, m)?)?;

@@ -10,8 +10,9 @@ use crate::tree::Tree;
 use numpy::{PyArray1, PyArrayMethods};
 use obbtree::format::ObbtFile;
 use obbtree::query::{
-    batch, on_threads, BatchOptions, CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose,
-    PoseBatch, QueryError, SpanOptions, ToleranceOptions, Witness, Work,
+    batch, on_threads, BatchOptions, CollideOptions, DescentRule, DistanceOptions,
+    HausdorffDirection, HausdorffOptions, PairQuery, Pose, PoseBatch, QueryError, SpanOptions,
+    ToleranceOptions, Witness, Work,
 };
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -481,6 +482,58 @@ witness_getters!(SpanResult, "of the farthest pair", {
     }
 });
 
+/// The answers of `hausdorff` for N pose pairs.
+///
+/// Attributes (read-only arrays): `distance` (N,) float64 — the Hausdorff distance found,
+/// the distance from the witness to the other model; `upper_bound` (N,) float64 — a
+/// proven bound the true distance does not exceed; `direction` (N,) str — `a_to_b` (the
+/// witness is `point_a`, on A) or `b_to_a` (only with `symmetric`: the witness is
+/// `point_b`); `point_a`, `point_b` (N, 3) — the witness and its closest point on the
+/// other model, world frame; `tri_a`, `tri_b` (N,) int64; `work`.
+#[pyclass(module = "obbtree", name = "HausdorffResult", frozen)]
+pub struct HausdorffResult {
+    columns: Witnesses,
+    arrays: WitnessArrays,
+    upper_bound: Vec<f64>,
+    upper_bound_array: PyOnceLock<Py<PyAny>>,
+    b_to_a: Vec<bool>,
+    direction_array: PyOnceLock<Py<PyAny>>,
+}
+
+witness_getters!(HausdorffResult, "of the witness pair", {
+    /// (N,) float64: the Hausdorff distance found (the true one is at least this).
+    #[getter]
+    fn distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        column(&self.arrays.distance, py, &self.columns.distance)
+    }
+
+    /// (N,) float64: a proven bound the true distance does not exceed.
+    #[getter]
+    fn upper_bound<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        column(&self.upper_bound_array, py, &self.upper_bound)
+    }
+
+    /// (N,) str: `a_to_b` where the witness is on A, `b_to_a` where it is on B.
+    #[getter]
+    fn direction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        cached(&self.direction_array, py, || {
+            let names: Vec<&str> = self
+                .b_to_a
+                .iter()
+                .map(|&b| if b { "b_to_a" } else { "a_to_b" })
+                .collect();
+            readonly(py.import("numpy")?.call_method1("array", (names,))?)
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<obbtree.HausdorffResult: {} poses>",
+            self.columns.distance.len()
+        )
+    }
+});
+
 /// Which triangle pairs touch, for each pose pair of a batch.
 ///
 /// a, b: `Tree`s (same volume type and precision). poses_a, poses_b: one pose — a (4, 4)
@@ -650,6 +703,71 @@ pub fn span(
     Ok(SpanResult {
         columns: Witnesses::new(answers, f64::NAN),
         arrays: WitnessArrays::default(),
+    })
+}
+
+/// The Hausdorff distance for each pose pair of a batch (poses as for `collide`): the
+/// largest distance from a point of A's surface to B's, with the witness point on A and
+/// its closest point on B; with `symmetric`, the larger of that and the reverse.
+///
+/// rel_err, abs_err: the error allowed, `h <= h* <= max(h (1 + rel_err), h + abs_err)`
+/// for the answer h and the true h*; with both 0 (the default) exact to f64 rounding,
+/// except where the farthest point lies where two triangles of B are equally near (then
+/// `upper_bound` says how close).
+///
+/// Returns a `HausdorffResult` (distance, upper_bound, direction, point_a, point_b, tri_a,
+/// tri_b, work). Raises `obbtree.OptionError` (a ValueError) for a negative or non-finite
+/// error allowance.
+#[pyfunction]
+#[pyo3(signature = (a, poses_a, b, poses_b, *, rel_err=0.0, abs_err=0.0, symmetric=false, threads=None, orthonormalize=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn hausdorff(
+    py: Python<'_>,
+    a: PyRef<'_, Tree>,
+    poses_a: &Bound<'_, PyAny>,
+    b: PyRef<'_, Tree>,
+    poses_b: &Bound<'_, PyAny>,
+    rel_err: f64,
+    abs_err: f64,
+    symmetric: bool,
+    threads: Option<i64>,
+    orthonormalize: bool,
+) -> PyResult<HausdorffResult> {
+    let options = HausdorffOptions {
+        rel_err,
+        abs_err,
+        symmetric,
+    };
+    let (fa, fb) = (a.file()?, b.file()?);
+    let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
+    let answers = batch.run(py, |_, pa, pb| {
+        obbtree::query::hausdorff(&fa, pa, &fb, pb, &options)
+    })?;
+    let upper_bound = answers.iter().map(|h| h.upper_bound).collect();
+    let b_to_a = answers
+        .iter()
+        .map(|h| h.direction == HausdorffDirection::BToA)
+        .collect();
+    let witnesses = answers
+        .into_iter()
+        .map(|h| {
+            let w = Witness {
+                distance: h.distance,
+                point_a: h.point_a.into(),
+                point_b: h.point_b.into(),
+                tri_a: h.tri_a,
+                tri_b: h.tri_b,
+            };
+            (Some(w), h.work)
+        })
+        .collect();
+    Ok(HausdorffResult {
+        columns: Witnesses::new(witnesses, f64::NAN),
+        arrays: WitnessArrays::default(),
+        upper_bound,
+        upper_bound_array: PyOnceLock::new(),
+        b_to_a,
+        direction_array: PyOnceLock::new(),
     })
 }
 

@@ -1,0 +1,342 @@
+//! Hausdorff distances (`query::hausdorff`): closed forms on squares, zero for coincident
+//! models, and on meshes against brute force: the witness's distance recomputed over every
+//! triangle of the other model, dense samples of the first model (vertices, edges, faces)
+//! never farther than the proven upper bound, and the bounds within the error asked.
+// Test code outside `#[test]` functions (helpers): a failure is a failed test.
+#![allow(clippy::expect_used, clippy::indexing_slicing)]
+
+use crate::closest::point_triangle_distance;
+use crate::common;
+
+use nalgebra::Vector3;
+use obbtree::build::{build, BuildOptions};
+use obbtree::format::ObbtFile;
+use obbtree::mesh::TriMesh;
+use obbtree::query::{
+    hausdorff, HausdorffDirection, HausdorffOptions, HausdorffResult, Pose, QueryError,
+};
+
+/// The unit square `[0, 1]^2` at height `z`, shifted by `dx` along x: two triangles.
+fn square(dx: f64, z: f64) -> ObbtFile {
+    let v = vec![
+        [dx, 0.0, z],
+        [dx + 1.0, 0.0, z],
+        [dx + 1.0, 1.0, z],
+        [dx, 1.0, z],
+    ];
+    let mesh = TriMesh::new(v, vec![[0, 1, 2], [0, 2, 3]]).expect("a square");
+    build(&mesh, &BuildOptions::default(), None).expect("builds")
+}
+
+/// A model's triangles posed in the world.
+fn world_triangles(file: &ObbtFile, pose: &Pose) -> Vec<(u32, [[f64; 3]; 3])> {
+    common::file_triangles(file)
+        .into_iter()
+        .map(|(id, t)| (id, t.map(|p| pose.apply(&Vector3::from(p)).into())))
+        .collect()
+}
+
+/// Distance from `p` to the nearest of `triangles`, by brute force.
+fn distance_to(p: &Vector3<f64>, triangles: &[(u32, [[f64; 3]; 3])]) -> f64 {
+    triangles
+        .iter()
+        .map(|(_, t)| point_triangle_distance(p, t))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The largest distance to `to` over samples of `from`: every corner, points along every
+/// edge and a barycentric grid inside every face (`k` steps per edge). A lower bound on the
+/// true h(from, to).
+fn sampled(from: &[(u32, [[f64; 3]; 3])], to: &[(u32, [[f64; 3]; 3])], k: u32) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (_, t) in from {
+        let [a, b, c] = t.map(Vector3::from);
+        for i in 0..=k {
+            for j in 0..=k - i {
+                let (u, v) = (f64::from(i) / f64::from(k), f64::from(j) / f64::from(k));
+                let p = a + (b - a) * u + (c - a) * v;
+                worst = worst.max(distance_to(&p, to));
+            }
+        }
+    }
+    worst
+}
+
+/// Checks `h` for h(A, B) (or h(B, A) when `h.direction` says so) against brute force.
+/// `samples` are [`sampled`] from A to B and from B to A.
+fn check(
+    h: &HausdorffResult,
+    a: &[(u32, [[f64; 3]; 3])],
+    b: &[(u32, [[f64; 3]; 3])],
+    samples: (f64, f64),
+    options: &HausdorffOptions,
+    floor_gap: f64,
+    what: &str,
+) {
+    let (from, to, witness, other, id, samples) = match h.direction {
+        HausdorffDirection::AToB => (a, b, h.point_a, h.point_b, h.tri_a, samples.0),
+        HausdorffDirection::BToA => (b, a, h.point_b, h.point_a, h.tri_b, samples.1),
+    };
+    let w = Vector3::from(witness);
+    // The witness lies on its triangle, at the distance reported from the other model,
+    // which its partner point realises.
+    let own = from.iter().find(|(i, _)| *i == id).expect("a triangle id");
+    assert!(
+        point_triangle_distance(&w, &own.1) <= 1e-12,
+        "{what}: witness off its triangle"
+    );
+    let brute = distance_to(&w, to);
+    let tol = 1e-12 * (1.0 + brute);
+    assert!(
+        (h.distance - brute).abs() <= tol,
+        "{what}: {} vs brute {brute}",
+        h.distance
+    );
+    assert!(
+        ((w - Vector3::from(other)).norm() - brute).abs() <= tol,
+        "{what}"
+    );
+    // No sample is farther than the upper bound, and the bounds are as close as asked.
+    assert!(
+        samples <= h.upper_bound + tol,
+        "{what}: sample {samples} > {}",
+        h.upper_bound
+    );
+    let allowed = (options.rel_err * h.distance)
+        .max(options.abs_err)
+        .max(floor_gap);
+    assert!(
+        h.upper_bound - h.distance <= allowed + tol,
+        "{what}: bounds {} .. {} wider than {allowed}",
+        h.distance,
+        h.upper_bound
+    );
+}
+
+#[test]
+fn squares_have_their_closed_form_distances() {
+    let options = HausdorffOptions::default();
+    let id = Pose::identity();
+    // Shifted half a side: the far edge of each is half a side from the other.
+    let (a, b) = (square(0.0, 0.0), square(0.5, 0.0));
+    let h = hausdorff(&a, &id, &b, &id, &options).expect("answers");
+    assert_eq!((h.distance, h.upper_bound), (0.5, 0.5));
+    assert_eq!(h.point_a[0], 0.0);
+    // Stacked one apart: every point is 1 from the other square.
+    let lifted = Pose::translation(0.0, 0.0, 1.0);
+    let h = hausdorff(&a, &id, &a, &lifted, &options).expect("answers");
+    assert_eq!((h.distance, h.upper_bound), (1.0, 1.0));
+    // A small square inside a large one's plane: h(small, large) = 0 but not the reverse.
+    let big = {
+        let v = vec![
+            [-1.0, -1.0, 0.0],
+            [2.0, -1.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [-1.0, 2.0, 0.0],
+        ];
+        let mesh = TriMesh::new(v, vec![[0, 1, 2], [0, 2, 3]]).expect("a square");
+        build(&mesh, &BuildOptions::default(), None).expect("builds")
+    };
+    let inside = hausdorff(&a, &id, &big, &id, &options).expect("answers");
+    assert_eq!(inside.distance, 0.0);
+    let both = HausdorffOptions {
+        symmetric: true,
+        ..options
+    };
+    let h = hausdorff(&a, &id, &big, &id, &both).expect("answers");
+    assert_eq!(h.direction, HausdorffDirection::BToA);
+    // A corner of the large square, (-1, -1) or a mirror, is sqrt(2) from the small one.
+    assert!((h.distance - 2f64.sqrt()).abs() <= 1e-15, "{}", h.distance);
+    let corners = [
+        [-1.0, -1.0, 0.0],
+        [2.0, -1.0, 0.0],
+        [2.0, 2.0, 0.0],
+        [-1.0, 2.0, 0.0],
+    ];
+    assert!(corners.contains(&h.point_b), "{:?}", h.point_b);
+}
+
+#[test]
+fn coincident_models_are_zero_apart() {
+    let file = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
+    let pose = common::turned_pose(3, 0.4);
+    let options = HausdorffOptions {
+        symmetric: true,
+        ..HausdorffOptions::default()
+    };
+    // Every vertex is on the other copy (distance exactly 0); points between vertices are
+    // where rounding puts them, within an ulp or so of the other copy's triangles.
+    for pose in [Pose::identity(), pose] {
+        let h = hausdorff(&file, &pose, &file, &pose, &options).expect("answers");
+        assert!(h.distance <= 1e-15 && h.upper_bound <= 1e-15, "{h:?}");
+    }
+    let square = square(0.0, 0.0);
+    let h = hausdorff(
+        &square,
+        &Pose::identity(),
+        &square,
+        &Pose::identity(),
+        &options,
+    );
+    assert_eq!(
+        h.map(|h| (h.distance, h.upper_bound)).expect("answers"),
+        (0.0, 0.0)
+    );
+}
+
+/// A copy of `mesh` with every vertex moved by up to `r` along each axis (seeded).
+fn noisy(mesh: &TriMesh, r: f64, seed: u64) -> TriMesh {
+    let mut rng = obbtree::generate::Rng::new(seed);
+    let v = mesh
+        .vertices()
+        .iter()
+        .map(|p| p.map(|x| x + r * rng.signed()))
+        .collect();
+    TriMesh::new(v, mesh.faces().to_vec()).expect("a mesh")
+}
+
+#[test]
+fn meshes_match_brute_force_for_every_tree_type() {
+    let sphere = common::uv_sphere(1.0, 8, 12);
+    let rough = noisy(&sphere, 0.03, 5);
+    let coarse = common::uv_sphere(1.05, 5, 7);
+    let cow = common::cow();
+    // (Brute force samples the first model, and the second for a symmetric case: the cow,
+    // of thousands of triangles, is only ever the second of a one-sided case.)
+    let cases = [
+        (
+            "sphere/noisy copy",
+            &sphere,
+            &rough,
+            Pose::identity(),
+            Pose::identity(),
+            true,
+        ),
+        (
+            "sphere/coarse sphere",
+            &sphere,
+            &coarse,
+            Pose::identity(),
+            common::turned_pose(1, 0.05),
+            true,
+        ),
+        (
+            "sphere/cow",
+            &sphere,
+            &cow,
+            common::turned_pose(2, 0.3),
+            Pose::identity(),
+            false,
+        ),
+    ];
+    let f64_tree = |mesh: &TriMesh| common::tree_f64(mesh);
+    for (name, a, b, pa, pb, both) in cases {
+        let (ta, tb) = (
+            world_triangles(&f64_tree(a), &pa),
+            world_triangles(&f64_tree(b), &pb),
+        );
+        let samples = (
+            sampled(&ta, &tb, 6),
+            if both { sampled(&tb, &ta, 6) } else { f64::NAN },
+        );
+        for options in common::all_options() {
+            let (fa, fb) = (
+                build(a, &options, None).expect("builds"),
+                build(b, &options, None).expect("builds"),
+            );
+            // f32 trees store rounded corners: compare with their own triangles.
+            let (ta, tb) = (world_triangles(&fa, &pa), world_triangles(&fb, &pb));
+            let rounded = options.precision == obbtree::real::Precision::F32;
+            // Pieces stop splitting at 2^-24 of the model's size, where the bounds of a
+            // piece on a boundary between two triangles' regions close linearly; f32
+            // corners move the samples by about as much.
+            let floor_gap = if rounded { 1e-5 } else { 1e-6 };
+            let samples = (samples.0 - floor_gap, samples.1 - floor_gap);
+            for (rel_err, symmetric) in [(0.0, false), (1e-3, false), (0.0, both)] {
+                let opts = HausdorffOptions {
+                    rel_err,
+                    abs_err: 0.0,
+                    symmetric,
+                };
+                let h = hausdorff(&fa, &pa, &fb, &pb, &opts).expect("answers");
+                let what = format!("{name} {options:?} rel_err {rel_err} symmetric {symmetric}");
+                check(&h, &ta, &tb, samples, &opts, floor_gap, &what);
+                if symmetric {
+                    let one = |x, px, y, py| {
+                        hausdorff(x, px, y, py, &HausdorffOptions::default())
+                            .expect("answers")
+                            .distance
+                    };
+                    let larger = one(&fa, &pa, &fb, &pb).max(one(&fb, &pb, &fa, &pa));
+                    assert_eq!(h.distance, larger, "{what}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_options_are_refused() {
+    let a = square(0.0, 0.0);
+    let id = Pose::identity();
+    for (rel_err, abs_err, name) in [
+        (-1.0, 0.0, "rel_err"),
+        (f64::NAN, 0.0, "rel_err"),
+        (0.0, f64::INFINITY, "abs_err"),
+    ] {
+        let options = HausdorffOptions {
+            rel_err,
+            abs_err,
+            symmetric: false,
+        };
+        let error = hausdorff(&a, &id, &a, &id, &options).expect_err("refused");
+        assert!(
+            matches!(error, QueryError::BadOption { name: n, .. } if n == name),
+            "{error}"
+        );
+    }
+}
+
+/// `obbtree hausdorff` prints what the library answers, and refuses bad options with one
+/// line and status 1.
+#[test]
+fn the_cli_answers_as_the_library() {
+    use common::cli::{assert_bad_input, cow, obbtree, stderr};
+    let file = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
+    let pose = "0,-1,0,1,0,0,0,0,1,0.05,0,0";
+    let pose_b =
+        Pose::from_row_major(&[0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.05, 0.0, 0.0])
+            .expect("a pose");
+    let options = HausdorffOptions {
+        symmetric: true,
+        ..HausdorffOptions::default()
+    };
+    let h = hausdorff(&file, &Pose::identity(), &file, &pose_b, &options).expect("answers");
+    let cow = cow();
+    let o = obbtree(&[
+        "hausdorff",
+        &cow,
+        &cow,
+        "--pose-b",
+        pose,
+        "--symmetric",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    let printed = line["hausdorff"].as_f64().expect("a number");
+    assert!(
+        (printed - h.distance).abs() <= 4.0 * f64::EPSILON * h.distance,
+        "{line}"
+    );
+    assert_eq!(line["tri_a"], h.tri_a);
+    assert_eq!(line["tri_b"], h.tri_b);
+    let direction = match h.direction {
+        HausdorffDirection::AToB => "a_to_b",
+        HausdorffDirection::BToA => "b_to_a",
+    };
+    assert_eq!(line["direction"], direction);
+    assert!(line["upper_bound"].as_f64().expect("a number") >= printed);
+    let o = obbtree(&["hausdorff", &cow, &cow, "--rel-err", "-0.5"]);
+    assert_bad_input(&o, "rel_err must be finite and at least 0, got -0.5");
+}
