@@ -176,6 +176,34 @@ unsafe fn outputs<'a, T>(
     unsafe { slots(ptr, len, name) }
 }
 
+/// What every point query reads first: the model, its `count` points (3 doubles each) and
+/// the `len` output slots at `out`, which must be `count`.
+///
+/// # Safety
+///
+/// `tree` is NULL or an open tree; `pose` NULL or 12 readable doubles; `points` NULL or
+/// `3 * count` readable doubles; `out` NULL or `len` writable values.
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+unsafe fn point_query<'a, T>(
+    tree: *const ObbtreeTree,
+    pose: *const f64,
+    threads: usize,
+    points: *const f64,
+    count: usize,
+    out: *mut T,
+    len: usize,
+    name: &str,
+) -> Result<(Model<'a>, Vec<[f64; 3]>, &'a mut [MaybeUninit<T>]), Error> {
+    // SAFETY: forwarded from the caller's contract.
+    unsafe {
+        Ok((
+            Model::new(tree, pose, threads)?,
+            rows(points, count, "points")?,
+            outputs(out, len, count, name)?,
+        ))
+    }
+}
+
 /// The rays of `count` origins and directions (3 doubles each, world frame).
 ///
 /// # Safety
@@ -380,12 +408,17 @@ pub unsafe extern "C" fn obbtree_closest_points(
     guard(|| {
         // SAFETY: forwarded from the caller's contract.
         let (model, points, results) = unsafe {
-            (
-                Model::new(tree, pose, threads)?,
-                rows(points, count, "points")?,
-                outputs(results, results_len, count, "results")?,
+            point_query(
+                tree,
+                pose,
+                threads,
+                points,
+                count,
+                results,
+                results_len,
+                "results",
             )
-        };
+        }?;
         let options = ClosestOptions { max_distance };
         let answers = model.run(|file, pose| closest_points(file, pose, &points, &options))?;
         for (slot, answer) in results.iter_mut().zip(&answers) {
@@ -468,13 +501,8 @@ pub unsafe extern "C" fn obbtree_winding_numbers(
 ) -> ObbtreeStatus {
     guard(|| {
         // SAFETY: forwarded from the caller's contract.
-        let (model, points, values) = unsafe {
-            (
-                Model::new(tree, pose, threads)?,
-                rows(points, count, "points")?,
-                outputs(values, len, count, "values")?,
-            )
-        };
+        let (model, points, values) =
+            unsafe { point_query(tree, pose, threads, points, count, values, len, "values") }?;
         let bounds = if error_bounds.is_null() {
             None
         } else {
@@ -522,13 +550,8 @@ pub unsafe extern "C" fn obbtree_signed_distances(
 ) -> ObbtreeStatus {
     guard(|| {
         // SAFETY: forwarded from the caller's contract.
-        let (model, points, values) = unsafe {
-            (
-                Model::new(tree, pose, threads)?,
-                rows(points, count, "points")?,
-                outputs(values, len, count, "values")?,
-            )
-        };
+        let (model, points, values) =
+            unsafe { point_query(tree, pose, threads, points, count, values, len, "values") }?;
         let options = winding_options(rule, parameter)?;
         let answers = model.run(|file, pose| signed_distances(file, pose, &points, &options))?;
         for (slot, answer) in values.iter_mut().zip(&answers) {
