@@ -30,102 +30,23 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[path = "support/peers.rs"]
+mod peers;
 
 use obbtree::build::{build, BuildOptions};
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
+use peers::{median_time, number, pose_entry, pose_line, run_peer, run_peer_with};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
-
-const MIN_RUNS: usize = 5;
-const MIN_TIME: f64 = 0.02;
-
-/// Median seconds per call of `f`, with the peers' rule (warm-up, then at least `MIN_RUNS`
-/// calls and `MIN_TIME` seconds).
-fn median_time(mut f: impl FnMut()) -> f64 {
-    f();
-    let mut times = Vec::new();
-    let mut total = 0.0;
-    while times.len() < MIN_RUNS || total < MIN_TIME {
-        let t0 = Instant::now();
-        f();
-        let dt = t0.elapsed().as_secs_f64();
-        times.push(dt);
-        total += dt;
-    }
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
-}
 
 struct Case {
     name: String,
     a: TriMesh,
     b: TriMesh,
     poses: Vec<(Pose, Pose)>,
-}
-
-/// One line of the poses file: `R_A T_A R_B T_B`, full precision.
-fn pose_line(a: &Pose, b: &Pose) -> String {
-    let mut numbers = Vec::new();
-    for p in [a, b] {
-        let r = p.rotation();
-        for i in 0..3 {
-            for j in 0..3 {
-                numbers.push(r[(i, j)]);
-            }
-        }
-        numbers.extend(p.translation_vector().iter());
-    }
-    let text: Vec<String> = numbers.iter().map(|v| format!("{v:?}")).collect();
-    text.join(" ")
-}
-
-/// The JSON lines a peer prints for a case, or `None` when the peer is not built.
-fn run_peer(dir: &Path, peer: &str, case: &Path) -> Option<Vec<Value>> {
-    run_peer_with(dir, peer, case, &[])
-}
-
-/// [`run_peer`] with extra arguments (`--build-reps N`: only the median build times).
-fn run_peer_with(dir: &Path, peer: &str, case: &Path, extra: &[&str]) -> Option<Vec<Value>> {
-    let binary = dir.join(peer);
-    if !binary.exists() {
-        return None;
-    }
-    let output = Command::new(&binary)
-        .arg(case.join("a.obj"))
-        .arg(case.join("b.obj"))
-        .arg(case.join("poses.txt"))
-        .args(["--min-runs", &MIN_RUNS.to_string()])
-        .args(["--min-time", &MIN_TIME.to_string()])
-        .args(extra)
-        .output()
-        .expect("runs the peer");
-    assert!(
-        output.status.success(),
-        "{peer} failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let text = String::from_utf8(output.stdout).expect("UTF-8");
-    Some(
-        text.lines()
-            .map(|l| serde_json::from_str(l).expect("a JSON line"))
-            .collect(),
-    )
-}
-
-/// The line of pose `index` among a peer's lines.
-fn pose_entry(lines: &Option<Vec<Value>>, index: usize) -> Option<&Value> {
-    lines
-        .as_ref()?
-        .iter()
-        .find(|v| v["pose"].as_u64() == Some(index as u64))
-}
-
-fn number(v: Option<&Value>, key: &str) -> Option<f64> {
-    v?.get(key)?.as_f64()
 }
 
 /// obbtree's answers and times at one pose.
