@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use obbtree::build::BuildOptions;
 use obbtree::experiment::median_time;
 use obbtree::format::ObbtFile;
+use obbtree::query::triangle::IntersectionKind;
 use obbtree::query::{
     BatchOptions, BoxTest, CollideOptions, DescentRule, DistanceOptions, HausdorffDirection,
     HausdorffOptions, PairQuery, Pose, PoseBatch, SpanOptions, ToleranceOptions, Witness, Work,
@@ -109,6 +110,12 @@ pub struct CollideArgs {
     /// List the contacting pairs (input-mesh triangle ids; not with --csv).
     #[arg(long, conflicts_with = "csv")]
     pub pairs: bool,
+    /// Also compute where the models meet: the length of the intersection curve, the area
+    /// coplanar triangles share and the box of every contact point (CSV columns
+    /// curve_length, overlap_area); with --json also each pair's segment or shared
+    /// polygon (world frame) and how far its points lie from the two triangles.
+    #[arg(long)]
+    pub geometry: bool,
     /// How box pairs are tested (for experiments; the answer is the same, the work not).
     #[arg(long, value_enum, default_value_t = BoxTestArg::Sat)]
     pub box_test: BoxTestArg,
@@ -423,9 +430,16 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
             BoxTestArg::Sat => BoxTest::SeparatingAxes,
             BoxTestArg::Rewrapped => BoxTest::Rewrapped,
         },
+        geometry: args.geometry,
         ..CollideOptions::default()
     };
-    let columns = csv_columns(&["/colliding", "/contacts", "/bv_test_lower_bound"]);
+    let columns = csv_columns(&[
+        "/colliding",
+        "/contacts",
+        "/bv_test_lower_bound",
+        "/curve_length",
+        "/overlap_area",
+    ]);
     let repeat = args.inputs.repeat;
     run_query(&args.inputs, (&a, &b), &columns, |pa, pb, pair| {
         let (r, seconds) = median_time(repeat, || pair.collide(pa, pb, &options))?;
@@ -442,6 +456,30 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
             let pairs = r.pairs.iter().map(|&(x, y)| [x, y]).collect::<Vec<_>>();
             insert(&mut value, "pairs", json!(pairs));
         }
+        if args.geometry {
+            insert(&mut value, "curve_length", json!(r.curve_length()));
+            insert(&mut value, "overlap_area", json!(r.overlap_area()));
+            insert(&mut value, "contact_bounds", json!(r.contact_bounds()));
+            let contacts: Vec<Value> = r
+                .contacts
+                .iter()
+                .map(|c| {
+                    let points: Vec<[f64; 3]> =
+                        c.intersection.points().iter().map(|&p| p.into()).collect();
+                    json!({
+                        "tri_a": c.tri_a,
+                        "tri_b": c.tri_b,
+                        "kind": match c.intersection.kind {
+                            IntersectionKind::Segment => "segment",
+                            IntersectionKind::Polygon => "polygon",
+                        },
+                        "points": points,
+                        "residual": c.intersection.residual,
+                    })
+                })
+                .collect();
+            insert(&mut value, "geometry", json!(contacts));
+        }
         let mut text = format!(
             "colliding: {}, {} contact{}{} ({}) in {:.6} s",
             if r.colliding { "yes" } else { "no" },
@@ -455,6 +493,13 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
             work_text(&r.work),
             seconds
         );
+        if args.geometry {
+            text.push_str(&format!(
+                "\nintersection curve {}, coplanar overlap area {}",
+                number(r.curve_length()),
+                number(r.overlap_area())
+            ));
+        }
         if args.pairs {
             for (x, y) in &r.pairs {
                 text.push_str(&format!("\n{x} {y}"));

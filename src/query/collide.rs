@@ -1,7 +1,7 @@
 //! Collision: every contacting triangle pair, or the first one found.
 
-use super::engine::{traverse, Flow, Policy, QueryContext};
-use super::triangle::{triangles_intersect, Triangle};
+use super::engine::{traverse, triangle, Flow, Policy, QueryContext};
+use super::triangle::{triangle_intersection, triangles_intersect, Triangle, TriangleIntersection};
 use super::{source_id, DescentRule, Pose, QueryError, Side, Work};
 use crate::bv::pair::{OFFSET_ROUNDING, SAT_GUARD};
 use crate::bv::BoundingVolume;
@@ -19,6 +19,8 @@ pub struct CollideOptions {
     pub guard: f64,
     /// How box pairs are tested; keep the default outside experiments.
     pub box_test: BoxTest,
+    /// Also compute where each contacting pair meets ([`CollideResult::contacts`]).
+    pub geometry: bool,
 }
 
 /// How a collision query tests two boxes (OBB or AABB trees; sphere trees always test
@@ -41,6 +43,7 @@ impl Default for CollideOptions {
             rule: DescentRule::default(),
             guard: SAT_GUARD,
             box_test: BoxTest::default(),
+            geometry: false,
         }
     }
 }
@@ -54,8 +57,44 @@ pub struct CollideResult {
     /// Contacting pairs as input-mesh ids `(id_a, id_b)`, sorted; one pair at most with
     /// `first_contact`.
     pub pairs: Vec<(u32, u32)>,
+    /// With [`CollideOptions::geometry`], where each pair of `pairs` meets, in the same
+    /// order; empty otherwise.
+    pub contacts: Vec<Contact>,
     /// Work done.
     pub work: Work,
+}
+
+/// Where a contacting triangle pair meets, world frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// Input-mesh id of A's triangle.
+    pub tri_a: u32,
+    /// Input-mesh id of B's triangle.
+    pub tri_b: u32,
+    /// The segment where they cross, or the polygon they share when coplanar.
+    pub intersection: TriangleIntersection,
+}
+
+impl CollideResult {
+    /// The length of the intersection curve: the summed lengths of the crossing pairs'
+    /// segments (world units; coplanar overlaps count in [`Self::overlap_area`]).
+    pub fn curve_length(&self) -> f64 {
+        self.contacts.iter().map(|c| c.intersection.length()).sum()
+    }
+
+    /// The summed area of the polygons coplanar pairs share.
+    pub fn overlap_area(&self) -> f64 {
+        self.contacts.iter().map(|c| c.intersection.area()).sum()
+    }
+
+    /// The axis-aligned box (world frame) of every contact point: `(min, max)`, `None`
+    /// without contacts.
+    pub fn contact_bounds(&self) -> Option<([f64; 3], [f64; 3])> {
+        let mut points = self.contacts.iter().flat_map(|c| c.intersection.points());
+        let first = points.next()?;
+        let (lo, hi) = points.fold((*first, *first), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+        Some((lo.into(), hi.into()))
+    }
 }
 
 struct Collide {
@@ -173,6 +212,22 @@ pub fn collide_into<B: BoundingVolume>(
     }
     result.pairs.sort_unstable();
     result.colliding = !result.pairs.is_empty();
+    result.contacts.clear();
+    if options.geometry {
+        for &(fa, fb) in &context.faces {
+            let ta = triangle(a, fa, None, Side::A)?;
+            let tb = triangle(b, fb, Some(&b_to_a), Side::B)?;
+            // (Always found: the exact test said these touch.)
+            if let Some(meet) = triangle_intersection(&ta, &tb) {
+                result.contacts.push(Contact {
+                    tri_a: source_id(a, fa, Side::A)?,
+                    tri_b: source_id(b, fb, Side::B)?,
+                    intersection: meet.posed(pose_a),
+                });
+            }
+        }
+        result.contacts.sort_unstable_by_key(|c| (c.tri_a, c.tri_b));
+    }
     Ok(())
 }
 

@@ -43,7 +43,7 @@ mod work;
 pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
 pub use batch::{batch, on_threads, BatchError, BatchOptions, PoseBatch};
 pub use closest::{closest_points, ClosestOptions, ClosestPoint, ClosestResult};
-pub use collide::{BoxTest, CollideOptions, CollideResult};
+pub use collide::{BoxTest, CollideOptions, CollideResult, Contact};
 pub use descent::DescentRule;
 pub use distance::{
     DistanceOptions, DistanceResult, ToleranceOptions, ToleranceResult, WarmStart, Witness,

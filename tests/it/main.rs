@@ -12,6 +12,7 @@ mod cad_work;
 mod cli;
 mod closest;
 mod concurrency;
+mod contact_geometry;
 mod contact_work;
 mod corruption;
 mod distance_work;

@@ -409,6 +409,38 @@ typedef struct ObbtreeSpanResult {
 } ObbtreeSpanResult;
 
 /**
+ * Where one contacting triangle pair meets, world frame.
+ */
+typedef struct ObbtreeContact {
+  /**
+   * Input-mesh id of A's triangle.
+   */
+  uint32_t tri_a;
+  /**
+   * Input-mesh id of B's triangle.
+   */
+  uint32_t tri_b;
+  /**
+   * 0: the triangles cross and `points` holds the two ends of the segment they share
+   * (equal when they touch at a point); 1: they are coplanar and `points` holds the
+   * corners of the polygon they share, in order.
+   */
+  bool coplanar;
+  /**
+   * How many of `points` are used (1 to 6).
+   */
+  uint32_t point_count;
+  /**
+   * The segment's ends or the polygon's corners; the unused ones are NaN.
+   */
+  double points[6][3];
+  /**
+   * The largest distance from one of `points` to either triangle, as computed.
+   */
+  double residual;
+} ObbtreeContact;
+
+/**
  * The answer of `obbtree_hausdorff`.
  */
 typedef struct ObbtreeHausdorffResult {
@@ -866,6 +898,30 @@ enum ObbtreeStatus obbtree_span_batch(const struct ObbtreeTree *a,
                                       size_t threads,
                                       struct ObbtreeSpanResult *results,
                                       size_t results_len);
+
+/**
+ * Every contacting triangle pair of A at `pose_a` and B at `pose_b` with where it meets,
+ * sorted by (A, B) id. The contacts go to `contacts`, which holds `capacity` of them
+ * (NULL and 0 for the totals only); `*count` gets the number of pairs, `*curve_length`
+ * the summed length of the crossing pairs' segments and `*overlap_area` the summed area
+ * of the polygons coplanar pairs share (each out pointer may be NULL). When `contacts` is
+ * too short the call returns `OBBTREE_STATUS_BUFFER_TOO_SMALL` with the totals complete
+ * and the first `capacity` contacts written.
+ *
+ * # Safety
+ *
+ * `pair` is NULL or a live handle; `pose_a`, `pose_b` are NULL or point at 12 readable
+ * doubles; `contacts` is NULL or points at `capacity` writable contacts; `count`,
+ * `curve_length`, `overlap_area` are NULL or writable. Outputs do not overlap.
+ */
+enum ObbtreeStatus obbtree_pair_contact_geometry(struct ObbtreePair *pair,
+                                                 const double *pose_a,
+                                                 const double *pose_b,
+                                                 struct ObbtreeContact *contacts,
+                                                 size_t capacity,
+                                                 size_t *count,
+                                                 double *curve_length,
+                                                 double *overlap_area);
 
 /**
  * The Hausdorff distance from A at `pose_a` to B at `pose_b`: the largest distance from a

@@ -46,8 +46,10 @@ use std::num::NonZeroUsize;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{Arc, Mutex, TryLockError};
 
+mod contacts;
 mod hausdorff;
 mod model;
+pub use contacts::*;
 pub use hausdorff::*;
 pub use model::*;
 

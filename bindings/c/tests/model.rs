@@ -1,5 +1,5 @@
-//! The one-model entry points (rays, closest points, winding numbers, signed distances)
-//! called as C would call them, each answer checked against the Rust API's on the cow,
+//! The one-model entry points (rays, closest points, winding numbers, signed distances),
+//! the Hausdorff distance and contact geometry, called as C would call them, each answer checked against the Rust API's on the cow,
 //! and each refusal with its code and message.
 
 mod common;
@@ -561,4 +561,82 @@ fn hausdorff_equals_the_rust_answer() {
         )
     };
     fails(status, ObbtreeStatus::NullPointer, "b is NULL");
+}
+
+#[test]
+fn contact_geometry_equals_the_rust_answer_and_reports_short_buffers() {
+    let cow = Cow::new("model-contacts");
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    let options = obbtree::query::CollideOptions {
+        geometry: true,
+        ..Default::default()
+    };
+    let want = obbtree::query::PairQuery::new(&cow.file, &cow.file)
+        .expect("a pair")
+        .collide(&Pose::identity(), &cow.pose, &options)
+        .expect("answers");
+    assert!(want.contacts.len() > 10, "{} contacts", want.contacts.len());
+    let mut pair = null_mut();
+    // SAFETY: open trees and a writable pointer.
+    ok(unsafe { obbtree_pair_new(cow.tree, cow.tree, &mut pair) });
+    let blank = ObbtreeContact {
+        tri_a: 0,
+        tri_b: 0,
+        coplanar: false,
+        point_count: 0,
+        points: [[0.0; 3]; 6],
+        residual: 0.0,
+    };
+    let call = |buffer: &mut [ObbtreeContact]| {
+        let (mut count, mut length, mut area) = (0usize, 0.0, 0.0);
+        // SAFETY: a live handle, 12 doubles each, `buffer.len()` writable contacts (NULL
+        // for none) and three writable totals.
+        let status = unsafe {
+            obbtree_pair_contact_geometry(
+                pair,
+                identity.as_ptr(),
+                POSE.as_ptr(),
+                if buffer.is_empty() {
+                    null_mut()
+                } else {
+                    buffer.as_mut_ptr()
+                },
+                buffer.len(),
+                &mut count,
+                &mut length,
+                &mut area,
+            )
+        };
+        (status, count, length, area)
+    };
+    let mut all = vec![blank; want.contacts.len()];
+    let (status, count, length, area) = call(&mut all);
+    ok(status);
+    assert_eq!(count, want.contacts.len());
+    assert_eq!((length, area), (want.curve_length(), want.overlap_area()));
+    for (got, c) in all.iter().zip(&want.contacts) {
+        assert_eq!((got.tri_a, got.tri_b), (c.tri_a, c.tri_b));
+        let points: Vec<[f64; 3]> = c.intersection.points().iter().map(|&p| p.into()).collect();
+        assert_eq!(&got.points[..got.point_count as usize], points.as_slice());
+    }
+    let mut short = vec![blank; 3];
+    fails(
+        call(&mut short).0,
+        ObbtreeStatus::BufferTooSmall,
+        &format!("holds 3 contacts but {} are needed", want.contacts.len()),
+    );
+    // (Unused points are NaN: compare what is used.)
+    let used = |c: &ObbtreeContact| {
+        (
+            c.tri_a,
+            c.tri_b,
+            c.points[..c.point_count as usize].to_vec(),
+        )
+    };
+    assert_eq!(
+        short.iter().map(used).collect::<Vec<_>>(),
+        all[..3].iter().map(used).collect::<Vec<_>>()
+    );
+    // SAFETY: made above, freed once.
+    unsafe { obbtree_pair_free(pair) };
 }

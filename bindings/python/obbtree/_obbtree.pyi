@@ -76,6 +76,15 @@ class CollideResult:
     def pairs(self) -> Optional[List[npt.NDArray[np.int64]]]:
         """N (k, 2) arrays of input-mesh triangle ids; None with pairs=False."""
     @property
+    def geometry(self) -> Optional[List[List[npt.NDArray[np.float64]]]]:
+        """With geometry=True: per pose, one (m, 3) array per pair (segment ends or shared polygon)."""
+    @property
+    def curve_length(self) -> Optional[npt.NDArray[np.float64]]:
+        """With geometry=True: (N,) length of the intersection curve."""
+    @property
+    def overlap_area(self) -> Optional[npt.NDArray[np.float64]]:
+        """With geometry=True: (N,) area shared by coplanar triangles."""
+    @property
     def work(self) -> Dict[str, npt.NDArray[np.int64]]:
         """(N,) arrays: bv_disjoint, bv_overlap, tri_separated, tri_contact, nodes_visited, bv_tests, tri_tests."""
     def __len__(self) -> int: ...
@@ -169,6 +178,7 @@ def collide(
     *,
     first_contact: bool = False,
     pairs: bool = True,
+    geometry: bool = False,
     threads: Optional[int] = None,
     orthonormalize: bool = False,
     rule: str = "diameter",

@@ -164,18 +164,25 @@ fn work_dict<'py>(py: Python<'py>, work: &[Work]) -> PyResult<Bound<'py, PyAny>>
     Ok(dict.into_any())
 }
 
+/// One pose's contact geometry: each pair's points, the curve length, the overlap area.
+type PoseGeometry = (Vec<Vec<[f64; 3]>>, f64, f64);
+
 /// The answers of `collide` for N pose pairs.
 ///
 /// Attributes: `contacts` (N,) int64 — contacting triangle pairs per pose (0 or 1 with
 /// `first_contact`); `colliding` (N,) bool; `pairs` — a list of N (k, 2) int64 arrays of
 /// input-mesh triangle ids (A's, B's), sorted, or None when called with `pairs=False`;
 /// `work` — a dict of (N,) int64 arrays (bv_disjoint, bv_overlap, tri_separated,
-/// tri_contact, nodes_visited, bv_tests, tri_tests: the CLI's `stats`). Arrays are
+/// tri_contact, nodes_visited, bv_tests, tri_tests: the CLI's `stats`); with
+/// `geometry=True` also `geometry`, `curve_length` and `overlap_area`. Arrays are
 /// read-only.
 #[pyclass(module = "obbtree", name = "CollideResult", frozen)]
 pub struct CollideResult {
     contacts: Vec<i64>,
     pairs: Option<Vec<Vec<(u32, u32)>>>,
+    /// With geometry=True: each pose's contact geometry.
+    geometry: Option<Vec<PoseGeometry>>,
+    geometry_list: PyOnceLock<Py<PyAny>>,
     work: Vec<Work>,
     contacts_array: PyOnceLock<Py<PyAny>>,
     colliding_array: PyOnceLock<Py<PyAny>>,
@@ -222,6 +229,50 @@ impl CollideResult {
             }
             Ok(list.into_any())
         })
+    }
+
+    /// With geometry=True, a list of N lists, one (m, 3) float64 array per contacting
+    /// pair in the order of `pairs`: the two ends of the segment where the triangles cross
+    /// (m = 2, equal when they touch at a point), or the corners of the polygon coplanar
+    /// triangles share (m = 1 to 6), world frame. None without geometry=True.
+    #[getter]
+    fn geometry<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let Some(geometry) = &self.geometry else {
+            return Ok(py.None().into_bound(py));
+        };
+        cached(&self.geometry_list, py, || {
+            let poses = PyList::empty(py);
+            for (contacts, _, _) in geometry {
+                let list = PyList::empty(py);
+                for points in contacts {
+                    let flat: Vec<f64> = points.iter().flatten().copied().collect();
+                    let array = PyArray1::from_vec(py, flat).reshape([points.len(), 3])?;
+                    list.append(readonly(array.into_any())?)?;
+                }
+                poses.append(list)?;
+            }
+            Ok(poses.into_any())
+        })
+    }
+
+    /// With geometry=True, (N,) float64: the length of each pose's intersection curve (the
+    /// crossing pairs' segments, summed); None without it.
+    #[getter]
+    fn curve_length<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        match &self.geometry {
+            Some(g) => readonly(PyArray1::from_iter(py, g.iter().map(|x| x.1)).into_any()),
+            None => Ok(py.None().into_bound(py)),
+        }
+    }
+
+    /// With geometry=True, (N,) float64: the area coplanar triangles share, summed; None
+    /// without it.
+    #[getter]
+    fn overlap_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        match &self.geometry {
+            Some(g) => readonly(PyArray1::from_iter(py, g.iter().map(|x| x.2)).into_any()),
+            None => Ok(py.None().into_bound(py)),
+        }
     }
 
     /// The work per pose: a dict of (N,) int64 arrays with the keys of the CLI's `stats`.
@@ -542,7 +593,8 @@ witness_getters!(HausdorffResult, "of the witness pair", {
 /// of one) broadcasts against a batch; two single poses give N = 1. World point = R p + t.
 ///
 /// first_contact: stop at the first contact (a yes/no answer with one witness pair; much
-/// faster). pairs: False skips building the pair lists. threads: None for every core, or
+/// faster). pairs: False skips building the pair lists. geometry: also where each pair
+/// meets (`geometry`, `curve_length`, `overlap_area`). threads: None for every core, or
 /// the number of threads for a batch. orthonormalize: replace each rotation by the nearest
 /// rotation (as the CLI's --orthonormalize; changes above 1e-2 are refused); without it a
 /// rotation must be orthonormal within 1e-6. rule: which tree to descend first (diameter,
@@ -552,7 +604,7 @@ witness_getters!(HausdorffResult, "of the witness pair", {
 /// with the GIL released. Raises `obbtree.PoseError` (a ValueError) naming the argument and
 /// pose index of a bad pose, `obbtree.Error` for trees of different kinds or a closed tree.
 #[pyfunction]
-#[pyo3(signature = (a, poses_a, b, poses_b, *, first_contact=false, pairs=true, threads=None, orthonormalize=false, rule="diameter"))]
+#[pyo3(signature = (a, poses_a, b, poses_b, *, first_contact=false, pairs=true, geometry=false, threads=None, orthonormalize=false, rule="diameter"))]
 #[allow(clippy::too_many_arguments)]
 pub fn collide(
     py: Python<'_>,
@@ -562,6 +614,7 @@ pub fn collide(
     poses_b: &Bound<'_, PyAny>,
     first_contact: bool,
     pairs: bool,
+    geometry: bool,
     threads: Option<i64>,
     orthonormalize: bool,
     rule: &str,
@@ -569,22 +622,38 @@ pub fn collide(
     let options = CollideOptions {
         first_contact,
         rule: self::rule(rule)?,
+        geometry,
         ..CollideOptions::default()
     };
     let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
     let answers = batch.run(py, |pair, pa, pb| {
         let r = pair.collide(pa, pb, &options)?;
-        Ok((r.pairs, r.work))
+        let shapes = geometry.then(|| {
+            let points = r
+                .contacts
+                .iter()
+                .map(|c| c.intersection.points().iter().map(|&p| p.into()).collect())
+                .collect();
+            (points, r.curve_length(), r.overlap_area())
+        });
+        Ok((r.pairs, shapes, r.work))
     })?;
     let contacts = answers
         .iter()
-        .map(|(p, _)| i64::try_from(p.len()).unwrap_or(i64::MAX))
+        .map(|(p, _, _)| i64::try_from(p.len()).unwrap_or(i64::MAX))
         .collect();
-    let work = answers.iter().map(|(_, w)| *w).collect();
-    let pair_lists = pairs.then(|| answers.into_iter().map(|(p, _)| p).collect());
+    let work = answers.iter().map(|(_, _, w)| *w).collect();
+    let mut shapes = Vec::with_capacity(answers.len());
+    let mut pair_lists = Vec::with_capacity(answers.len());
+    for (p, g, _) in answers {
+        pair_lists.push(p);
+        shapes.extend(g);
+    }
     Ok(CollideResult {
         contacts,
-        pairs: pair_lists,
+        pairs: pairs.then_some(pair_lists),
+        geometry: geometry.then_some(shapes),
+        geometry_list: PyOnceLock::new(),
         work,
         contacts_array: PyOnceLock::new(),
         colliding_array: PyOnceLock::new(),

@@ -17,16 +17,20 @@
 //! - [`triangle_max_distance`]: maximum distance, attained at a corner pair.
 //! - [`closest_point_on_triangle`]: the closest point of one triangle to a point, with the
 //!   [`Feature`] (face, edge, corner) it lies on.
+//! - [`triangle_intersection`]: where two touching triangles meet: the segment of a
+//!   crossing pair, the shared polygon of a coplanar one.
 //! - [`RaySpace::intersect`]: where a ray meets a triangle, watertight: a ray on an edge
 //!   shared by two triangles meets exactly one of them.
 
 mod distance;
+mod intersection;
 mod overlap;
 mod point;
 mod predicates;
 mod ray;
 
 pub use distance::{triangle_distance, triangle_max_distance};
+pub use intersection::{triangle_intersection, IntersectionKind, TriangleIntersection};
 pub use overlap::triangles_intersect;
 pub use point::{closest_point_on_triangle, Feature};
 pub use ray::{RaySpace, RayTriangleHit};

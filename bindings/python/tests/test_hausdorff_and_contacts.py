@@ -1,5 +1,5 @@
 """obbtree.hausdorff: closed forms on squares, batches against one-at-a-time calls and the
-CLI, the symmetric measure, and refusals."""
+CLI, the symmetric measure, and refusals; collide(geometry=True): where the pairs meet."""
 
 import numpy as np
 import pytest
@@ -58,3 +58,17 @@ def test_bad_options_raise(cow):
         obbtree.hausdorff(cow, np.eye(4), cow, np.eye(4), abs_err=float("nan"))
     with pytest.raises(obbtree.PoseError):
         obbtree.hausdorff(cow, np.eye(4), cow, np.eye(4) * 2)
+
+
+def test_collide_geometry_gives_each_pair_its_segment(cow):
+    pose = np.eye(4)
+    pose[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    pose[0, 3] = 0.05
+    r = obbtree.collide(cow, np.eye(4), cow, pose, geometry=True)
+    (pieces,) = r.geometry
+    assert len(pieces) == r.contacts[0] > 0
+    lengths = sum(float(np.linalg.norm(p[1] - p[0])) for p in pieces if len(p) == 2)
+    assert abs(r.curve_length[0] - lengths) <= 1e-9 * lengths
+    plain = obbtree.collide(cow, np.eye(4), cow, pose)
+    assert plain.geometry is None and plain.curve_length is None
+    np.testing.assert_array_equal(plain.pairs[0], r.pairs[0])
