@@ -25,7 +25,6 @@ mod common;
 mod peers;
 
 use obbtree::build::{build, BuildOptions};
-use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{hausdorff, HausdorffOptions, Pose};
 use obbtree::real::Precision;
@@ -45,17 +44,6 @@ fn diagonal(mesh: &TriMesh) -> f64 {
         }
     }
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
-}
-
-/// `mesh` with every vertex coordinate moved by up to `r` (seeded).
-fn noisy(mesh: &TriMesh, r: f64) -> TriMesh {
-    let mut rng = Rng::new(3);
-    let v = mesh
-        .vertices()
-        .iter()
-        .map(|p| p.map(|x| x + r * rng.signed()))
-        .collect();
-    TriMesh::new(v, mesh.faces().to_vec()).expect("a mesh")
 }
 
 /// A small turn and a shift of a hundredth of `scale`.
@@ -84,7 +72,7 @@ fn main() {
         cases.push((
             "bunny/noisy copy".into(),
             bunny.clone(),
-            noisy(&bunny, 1e-3 * d),
+            common::noisy(&bunny, 1e-3 * d, 3),
             Pose::identity(),
         ));
         cases.push((

@@ -35,6 +35,18 @@ pub fn cuboid(half: [f64; 3], center: [f64; 3]) -> TriMesh {
     obbtree::generate::cuboid(half, center).expect("valid cuboid")
 }
 
+/// A copy of `mesh` with every vertex coordinate moved by up to `r` (seeded): a noisy
+/// scan of it.
+pub fn noisy(mesh: &TriMesh, r: f64, seed: u64) -> TriMesh {
+    let mut rng = obbtree::generate::Rng::new(seed);
+    let v = mesh
+        .vertices()
+        .iter()
+        .map(|p| p.map(|x| x + r * rng.signed()))
+        .collect();
+    TriMesh::new(v, mesh.faces().to_vec()).expect("a mesh")
+}
+
 /// A flat `n x n` grid of unit squares in the plane z = 0, `2 n^2` triangles.
 pub fn grid(n: u32) -> TriMesh {
     // The library's plate of unit cells, moved from centred to a corner at the origin.

@@ -184,21 +184,10 @@ fn coincident_models_are_zero_apart() {
     );
 }
 
-/// A copy of `mesh` with every vertex moved by up to `r` along each axis (seeded).
-fn noisy(mesh: &TriMesh, r: f64, seed: u64) -> TriMesh {
-    let mut rng = obbtree::generate::Rng::new(seed);
-    let v = mesh
-        .vertices()
-        .iter()
-        .map(|p| p.map(|x| x + r * rng.signed()))
-        .collect();
-    TriMesh::new(v, mesh.faces().to_vec()).expect("a mesh")
-}
-
 #[test]
 fn meshes_match_brute_force_for_every_tree_type() {
     let sphere = common::uv_sphere(1.0, 8, 12);
-    let rough = noisy(&sphere, 0.03, 5);
+    let rough = common::noisy(&sphere, 0.03, 5);
     let coarse = common::uv_sphere(1.05, 5, 7);
     let cow = common::cow();
     // (Brute force samples the first model, and the second for a symmetric case: the cow,
