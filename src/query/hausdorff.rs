@@ -305,35 +305,45 @@ impl Ord for Piece {
     }
 }
 
-/// The convexity bound of a piece: over the candidate triangles (those nearest its
-/// corners, and `extra`), the least of the largest corner distance to that triangle.
+/// The convexity bound of a piece for one candidate triangle `face` of B: the largest
+/// distance from a corner to it (over the piece, the distance to one triangle is largest
+/// at a corner).
+fn candidate_bound<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    corners: &[Vector3<f64>; 3],
+    near: &[Near; 3],
+    face: u32,
+    work: &mut Work,
+) -> Result<f64, QueryError> {
+    let t = triangle(tree, face, None, Side::B)?;
+    let mut worst: f64 = 0.0;
+    for (corner, n) in corners.iter().zip(near) {
+        // The nearest triangle's distance is known.
+        let d = if n.face == face {
+            n.distance
+        } else {
+            work.tri_separated += 1;
+            let (q, _) = closest_point_on_triangle(corner, &t);
+            (corner - q).norm()
+        };
+        worst = worst.max(d);
+    }
+    Ok(worst)
+}
+
+/// The convexity bound of a piece over the candidate triangles nearest its corners: the
+/// least of their [`candidate_bound`]s.
 fn upper_bound<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     corners: &[Vector3<f64>; 3],
     near: &[Near; 3],
-    extra: Option<u32>,
     work: &mut Work,
 ) -> Result<f64, QueryError> {
     let mut best = f64::INFINITY;
-    let candidates = near.iter().map(|n| n.face).chain(extra);
-    for (k, face) in candidates.enumerate() {
-        if near.iter().take(k).any(|n| n.face == face) {
-            continue;
+    for (k, n) in near.iter().enumerate() {
+        if near.iter().take(k).all(|m| m.face != n.face) {
+            best = best.min(candidate_bound(tree, corners, near, n.face, work)?);
         }
-        let t = triangle(tree, face, None, Side::B)?;
-        let mut worst: f64 = 0.0;
-        for (corner, n) in corners.iter().zip(near) {
-            // The nearest triangle's distance is known.
-            let d = if n.face == face {
-                n.distance
-            } else {
-                work.tri_separated += 1;
-                let (q, _) = closest_point_on_triangle(corner, &t);
-                (corner - q).norm()
-            };
-            worst = worst.max(d);
-        }
-        best = best.min(worst);
     }
     Ok(best)
 }
@@ -349,12 +359,15 @@ fn bounded_piece<B: BoundingVolume>(
     threshold: f64,
     (heap, work): (&mut BinaryHeap<Waiting>, &mut Work),
 ) -> Result<(Piece, Option<Measured>), QueryError> {
-    let mut upper = upper_bound(tree, &corners, &near, None, work)?;
+    let mut upper = upper_bound(tree, &corners, &near, work)?;
     let mut middle = None;
     if upper > threshold {
         let c = (corners[0] + corners[1] + corners[2]) / 3.0;
         let n = self::near(tree, &c, Some(near[0].face), heap, work)?;
-        upper = upper.min(upper_bound(tree, &corners, &near, Some(n.face), work)?);
+        // (A corner's triangle is bounded already.)
+        if near.iter().all(|m| m.face != n.face) {
+            upper = upper.min(candidate_bound(tree, &corners, &near, n.face, work)?);
+        }
         middle = Some((c, n));
     }
     let piece = Piece {

@@ -53,9 +53,8 @@ from ._obbtree import (
     __version__,
     _build,
     _closest,
+    _inside,
     _ray,
-    _signed_distance,
-    _winding_number,
     collide,
     distance,
     hausdorff,
@@ -380,8 +379,8 @@ def winding_number(
     (naming the first), ``beta`` not above 1 or a negative ``tolerance``; ``PoseError`` for a
     pose that is not a rigid motion.
     """
-    value = _winding_number(tree, pose, _point_rows(points), float(beta),
-                            _tolerance(tolerance), orthonormalize, threads)
+    value = _inside(tree, pose, _point_rows(points), float(beta), _tolerance(tolerance),
+                    orthonormalize, threads, False)
     value.flags.writeable = False
     return value
 
@@ -403,8 +402,8 @@ def signed_distance(
 
     Raises as ``winding_number``.
     """
-    value = _signed_distance(tree, pose, _point_rows(points), float(beta),
-                             _tolerance(tolerance), orthonormalize, threads)
+    value = _inside(tree, pose, _point_rows(points), float(beta), _tolerance(tolerance),
+                    orthonormalize, threads, True)
     value.flags.writeable = False
     return value
 

@@ -288,7 +288,7 @@ def _ray(
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
 ]: ...
-def _winding_number(
+def _inside(
     tree: Tree,
     pose: Poses,
     points: npt.NDArray[np.float64],
@@ -296,15 +296,7 @@ def _winding_number(
     tolerance: Optional[float],
     orthonormalize: bool,
     threads: Optional[int],
-) -> npt.NDArray[np.float64]: ...
-def _signed_distance(
-    tree: Tree,
-    pose: Poses,
-    points: npt.NDArray[np.float64],
-    beta: float,
-    tolerance: Optional[float],
-    orthonormalize: bool,
-    threads: Optional[int],
+    signed: bool,
 ) -> npt.NDArray[np.float64]: ...
 def _time_rust_loop(
     a: Tree, poses_a: Poses, b: Tree, poses_b: Poses, query: str, repeat: int

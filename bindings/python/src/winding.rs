@@ -35,12 +35,13 @@ fn accuracy(beta: f64, tolerance: Option<f64>) -> WindingOptions {
     WindingOptions { accuracy }
 }
 
-/// The native half of `obbtree.winding_number` (which documents it): `points` an (N, 3)
-/// float64 array. Returns the (N,) winding numbers.
+/// The native half of `obbtree.winding_number` and `obbtree.signed_distance` (which
+/// document it): `points` an (N, 3) float64 array. Returns the (N,) winding numbers, or
+/// with `signed` the (N,) signed distances.
 #[pyfunction]
-#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize, threads))]
+#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize, threads, signed))]
 #[allow(clippy::too_many_arguments)]
-pub fn _winding_number<'py>(
+pub fn _inside<'py>(
     py: Python<'py>,
     tree: PyRef<'_, Tree>,
     pose: &Bound<'py, PyAny>,
@@ -49,38 +50,21 @@ pub fn _winding_number<'py>(
     tolerance: Option<f64>,
     orthonormalize: bool,
     threads: Option<i64>,
+    signed: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
     let query = point_rows(&points)?;
     let options = accuracy(beta, tolerance);
-    let answers = detached(py, threads, || {
-        winding_numbers(&file, &pose, &query, &options).map_err(Failure::from)
+    let values = detached(py, threads, || {
+        Ok(if signed {
+            signed_distances(&file, &pose, &query, &options)?
+        } else {
+            winding_numbers(&file, &pose, &query, &options)?
+                .iter()
+                .map(|w| w.value)
+                .collect()
+        })
     })?;
-    Ok(PyArray1::from_iter(py, answers.iter().map(|w| w.value)))
-}
-
-/// The native half of `obbtree.signed_distance` (which documents it): the (N,) signed
-/// distances at an (N, 3) float64 array of points.
-#[pyfunction]
-#[pyo3(signature = (tree, pose, points, beta, tolerance, orthonormalize, threads))]
-#[allow(clippy::too_many_arguments)]
-pub fn _signed_distance<'py>(
-    py: Python<'py>,
-    tree: PyRef<'_, Tree>,
-    pose: &Bound<'py, PyAny>,
-    points: PyReadonlyArray2<'py, f64>,
-    beta: f64,
-    tolerance: Option<f64>,
-    orthonormalize: bool,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let file = tree.file()?;
-    let pose = single_pose("pose", pose, orthonormalize)?;
-    let query = point_rows(&points)?;
-    let options = accuracy(beta, tolerance);
-    let answers = detached(py, threads, || {
-        signed_distances(&file, &pose, &query, &options).map_err(Failure::from)
-    })?;
-    Ok(PyArray1::from_vec(py, answers))
+    Ok(PyArray1::from_vec(py, values))
 }

@@ -7,7 +7,7 @@
 //! [`TriangleIntersection::residual`] says how far from either triangle they landed.
 
 use super::predicates::{dominant_axis, orient2d, orient3d, project};
-use super::{closest_point_on_triangle, triangle_distance, Triangle};
+use super::{closest_point_on_triangle, triangle_distance, triangles_intersect, Triangle};
 use nalgebra::Vector3;
 
 /// The shape two touching triangles share.
@@ -100,12 +100,12 @@ impl TriangleIntersection {
 /// when they do not after all (the caller asked about a pair that does not touch). A
 /// zero-area triangle meets the other at the one point of contact its closest pair gives.
 pub fn triangle_intersection(a: &Triangle, b: &Triangle) -> Option<TriangleIntersection> {
-    let touching = triangle_distance(a, b);
-    if touching.distance > 0.0 {
+    if !triangles_intersect(a, b) {
         return None;
     }
+    // The point a closest pair finds (at distance 0): the answer where no shape is found.
     let single = || {
-        let p = touching.point_a;
+        let p = triangle_distance(a, b).point_a;
         TriangleIntersection::new(IntersectionKind::Segment, &[p, p], a, b)
     };
     let (Some(_), Some(axis)) = (dominant_axis(b), dominant_axis(a)) else {
@@ -152,22 +152,29 @@ pub fn triangle_intersection(a: &Triangle, b: &Triangle) -> Option<TriangleInter
 /// its corners on the plane and the points where its edges cross it (one or two points,
 /// the second equal to the first when there is one).
 fn section(t: &Triangle, side: &[f64; 3]) -> Option<[Vector3<f64>; 2]> {
-    let mut points: Vec<Vector3<f64>> = Vec::with_capacity(3);
+    let mut points = [Vector3::zeros(); 3];
+    let mut count = 0;
+    let mut push = |p: Vector3<f64>| {
+        if let Some(slot) = points.get_mut(count) {
+            *slot = p;
+            count += 1;
+        }
+    };
     // Each corner with the next one: the edges.
     let next = [(t[1], side[1]), (t[2], side[2]), (t[0], side[0])];
     for ((ti, si), (tj, sj)) in t.iter().zip(side).zip(next) {
         if *si == 0.0 {
-            points.push(*ti);
+            push(*ti);
         }
         if (*si < 0.0 && sj > 0.0) || (*si > 0.0 && sj < 0.0) {
             // The crossing divides the edge as the corners' (exact-signed) heights do.
             let u = (si / (si - sj)).clamp(0.0, 1.0);
-            points.push(ti + (tj - ti) * u);
+            push(ti + (tj - ti) * u);
         }
     }
-    match points.as_slice() {
-        [p] => Some([*p, *p]),
-        [p, q] => Some([*p, *q]),
+    match (count, points) {
+        (1, [p, ..]) => Some([p, p]),
+        (2, [p, q, _]) => Some([p, q]),
         // (Three only for a triangle in the plane: the coplanar case, handled apart.)
         _ => None,
     }
