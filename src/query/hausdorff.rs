@@ -12,19 +12,25 @@
 //! of B is nearest a whole piece the bounds meet, so most pieces end at once; where the
 //! farthest point sits on the boundary between two triangles' regions, the bounds close
 //! linearly with the piece's size and splitting stops at a floor, the gap left reported.
+//!
+//! Before any piece, A's own tree culls: a sample of A's vertices gives a first lower
+//! bound, and a node whose ball (centre's distance to B plus radius) cannot exceed it is
+//! dropped with its triangles, whose vertices are then never measured. Far apart models,
+//! where the distance varies little over A, lose most of their nodes near the root.
 
 use super::closest::{descend, Found, Waiting, WARM_RUN};
-use super::engine::triangle;
+use super::engine::{corrupt, triangle};
 use super::triangle::closest_point_on_triangle;
 use super::{QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
-use crate::tree::TreeView;
+use crate::real::point_to_f64;
+use crate::tree::{NodeDefect, NodeKind, TreeView};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
 /// How a Hausdorff distance is asked.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -73,7 +79,8 @@ pub struct HausdorffResult {
     /// Input-mesh id of B's triangle holding `point_b`.
     pub tri_b: u32,
     /// Work done: the closest-point descents' volume and triangle tests, plus the
-    /// triangle tests of the upper bounds; `nodes_visited` also counts the pieces split.
+    /// triangle tests of the upper bounds; `nodes_visited` also counts A's nodes examined
+    /// for culling and the pieces split.
     pub work: Work,
 }
 
@@ -178,41 +185,75 @@ fn one_sided(
     pose_to: &Pose,
     options: &HausdorffOptions,
 ) -> Result<OneSided, QueryError> {
-    /// `from`'s triangles (with their input ids) in `to`'s model frame.
-    struct Triangles {
+    /// `from`'s vertices, faces (with their input ids) and nodes, in `to`'s model frame.
+    struct Flatten {
         from_to_to: Pose,
     }
-    impl TreeVisitor for Triangles {
-        type Output = Result<Vec<([Vector3<f64>; 3], u32)>, QueryError>;
+    impl TreeVisitor for Flatten {
+        type Output = Result<FromModel, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            let faces = u32::try_from(tree.faces().len()).map_err(|_| QueryError::CorruptTree {
-                which: Side::A,
-                what: "more faces than ids",
-            })?;
-            (0..faces)
-                .map(|face| {
-                    let t = triangle(&tree, face, Some(&self.from_to_to), Side::A)?;
-                    Ok((t, super::source_id(&tree, face, Side::A)?))
+            let vertices: Vec<Vector3<f64>> = tree
+                .vertices()
+                .iter()
+                .map(|v| self.from_to_to.apply(&point_to_f64(v).into()))
+                .collect();
+            let faces: Vec<[usize; 3]> =
+                tree.faces().iter().map(|f| f.map(|v| v as usize)).collect();
+            if faces.iter().flatten().any(|&v| v >= vertices.len()) {
+                return Err(QueryError::CorruptTree {
+                    which: Side::A,
+                    what: "face or vertex index out of bounds",
+                });
+            }
+            let ids = tree.source_ids().to_vec();
+            if ids.len() != faces.len() {
+                return Err(QueryError::CorruptTree {
+                    which: Side::A,
+                    what: "face index out of bounds",
+                });
+            }
+            let nodes = (0..tree.nodes().len())
+                .map(|index| {
+                    let index = u32::try_from(index).map_err(|_| QueryError::CorruptTree {
+                        which: Side::A,
+                        what: "more nodes than ids",
+                    })?;
+                    let kind = tree.node_kind(index).map_err(|d| corrupt(Side::A, d))?;
+                    let node = tree
+                        .node(index)
+                        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
+                    let (centre, radius) = node.bv.enclosing_ball();
+                    Ok(Ball {
+                        centre: self.from_to_to.apply(&centre.into()),
+                        radius,
+                        kind,
+                    })
                 })
-                .collect()
+                .collect::<Result<_, QueryError>>()?;
+            Ok(FromModel {
+                vertices,
+                faces,
+                ids,
+                nodes,
+            })
         }
     }
-    let triangles = from.visit(Triangles {
+    let from = from.visit(Flatten {
         from_to_to: Pose::relative(pose_to, pose_from),
     })??;
     /// The bounds, run on `to`'s typed tree.
     struct Bounds<'q> {
-        triangles: &'q [([Vector3<f64>; 3], u32)],
+        from: &'q FromModel,
         options: &'q HausdorffOptions,
     }
     impl TreeVisitor for Bounds<'_> {
         type Output = Result<Local, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            bound(&tree, self.triangles, self.options)
+            bound(&tree, self.from, self.options)
         }
     }
     let local = to.visit(Bounds {
-        triangles: &triangles,
+        from: &from,
         options,
     })??;
     Ok(OneSided {
@@ -387,25 +428,242 @@ struct Witness {
     triangle: u32,
 }
 
+/// `from`'s surface as the bounds read it, in `to`'s model frame.
+struct FromModel {
+    /// The vertices.
+    vertices: Vec<Vector3<f64>>,
+    /// Leaf-ordered faces: indices into `vertices`, checked.
+    faces: Vec<[usize; 3]>,
+    /// The faces' input ids.
+    ids: Vec<u32>,
+    /// `from`'s tree, the root first.
+    nodes: Vec<Ball>,
+}
+
+/// A node of `from`'s tree: a ball holding its part of the surface, and what it holds.
+struct Ball {
+    centre: Vector3<f64>,
+    radius: f64,
+    kind: NodeKind,
+}
+
+/// One vertex in this many is measured before the nodes of `from` are culled, for a first
+/// lower bound; the rest only where their triangles survive.
+const SAMPLE_STRIDE: usize = 16;
+
+/// Measures the vertices `which` (indices into `vertices`) into `nearest`, in runs seeded as
+/// closest points are.
+fn measure<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    vertices: &[Vector3<f64>],
+    which: &[usize],
+    nearest: &mut [Option<Near>],
+    work: &mut Work,
+) -> Result<(), QueryError> {
+    let measured: Vec<Vec<(usize, Near, Work)>> = which
+        .par_chunks(WARM_RUN)
+        .map_init(BinaryHeap::new, |heap, run| {
+            let mut seed = None;
+            run.iter()
+                .filter_map(|&v| vertices.get(v).map(|p| (v, p)))
+                .map(|(v, p)| {
+                    let mut done = Work::default();
+                    let n = near(tree, p, seed, heap, &mut done)?;
+                    seed = Some(n.face);
+                    Ok((v, n, done))
+                })
+                .collect::<Result<Vec<_>, QueryError>>()
+        })
+        .collect::<Result<_, QueryError>>()?;
+    for (v, n, done) in measured.into_iter().flatten() {
+        *work += done;
+        if let Some(slot) = nearest.get_mut(v) {
+            *slot = Some(n);
+        }
+    }
+    Ok(())
+}
+
+/// A node of `from` waiting in [`cull`]: its upper bound, and the last centre measured on
+/// the way to it with what is nearest that centre.
+struct Open {
+    upper: f64,
+    index: u32,
+    known: Option<(Vector3<f64>, Near)>,
+}
+
+impl PartialEq for Open {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Open {}
+impl PartialOrd for Open {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Open {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.upper.total_cmp(&other.upper)
+    }
+}
+
+/// What [`cull`] reads and raises: the vertices measured and the farthest of them.
+struct Measures<'m> {
+    nearest: &'m mut [Option<Near>],
+    witness: &'m mut Witness,
+    /// A vertex's witness triangle (input id).
+    owner: &'m [u32],
+}
+
+/// The nodes of `from` that may hold a point farther from `to` than the lower bound
+/// allows (`enough` of it): the faces of the leaves kept (sorted), and the largest upper
+/// bound of those culled. A node's points are within its ball, so none is farther from
+/// `to` than the distance of the ball's centre plus its radius; a child first tries its
+/// parent's measurement moved by the distance between the centres, and a centre is
+/// measured only where that can cull (the radius alone within the allowance). Nodes are
+/// taken largest bound first, and a leaf reached under a finite bound has its vertices
+/// measured at once: the farthest part of `from` comes first and raises the lower bound
+/// that culls the rest. (Leaves reached without a bound, as when the models nearly
+/// coincide, leave their vertices to the parallel pass after.)
+fn cull<B: BoundingVolume>(
+    tree: &TreeView<'_, B>,
+    from: &FromModel,
+    enough: impl Fn(f64) -> f64,
+    measures: Measures<'_>,
+    work: &mut Work,
+) -> Result<(Vec<u32>, f64), QueryError> {
+    let Measures {
+        nearest,
+        witness,
+        owner,
+    } = measures;
+    let mut live = Vec::new();
+    let mut culled: f64 = 0.0;
+    let mut scratch = BinaryHeap::new();
+    let mut open = BinaryHeap::from([Open {
+        upper: f64::INFINITY,
+        index: 0,
+        known: None,
+    }]);
+    while let Some(Open {
+        upper,
+        index,
+        known,
+    }) = open.pop()
+    {
+        let threshold = enough(witness.near.distance);
+        if upper <= threshold {
+            // Every node still open is bounded by this one.
+            culled = culled.max(upper);
+            break;
+        }
+        let ball = from
+            .nodes
+            .get(index as usize)
+            .ok_or(QueryError::CorruptTree {
+                which: Side::A,
+                what: "a child past the node array",
+            })?;
+        work.nodes_visited += 1;
+        let mut here = known;
+        let mut upper = upper;
+        if ball.radius < threshold && known.is_none_or(|(c, _)| c != ball.centre) {
+            let seed = known.map(|(_, n)| n.face);
+            let n = near(tree, &ball.centre, seed, &mut scratch, work)?;
+            upper = n.distance + ball.radius;
+            if upper <= threshold {
+                culled = culled.max(upper);
+                continue;
+            }
+            here = Some((ball.centre, n));
+        }
+        match &ball.kind {
+            NodeKind::Faces(faces) => {
+                if upper.is_finite() {
+                    let mut seed = here.map(|(_, n)| n.face);
+                    for face in faces.clone() {
+                        for &v in from.faces.get(face as usize).into_iter().flatten() {
+                            let (Some(slot), Some(p)) = (nearest.get_mut(v), from.vertices.get(v))
+                            else {
+                                continue;
+                            };
+                            let n = match slot {
+                                Some(n) => *n,
+                                None => *slot.insert(near(tree, p, seed, &mut scratch, work)?),
+                            };
+                            seed = Some(n.face);
+                            if n.distance > witness.near.distance {
+                                *witness = Witness {
+                                    point: *p,
+                                    near: n,
+                                    triangle: owner.get(v).copied().unwrap_or_default(),
+                                };
+                            }
+                        }
+                    }
+                }
+                live.extend(faces.clone());
+            }
+            // (Children come after their parent: the pass ends on any file.)
+            NodeKind::Children(children) => {
+                for child in children.clone() {
+                    let ball = from
+                        .nodes
+                        .get(child as usize)
+                        .ok_or(QueryError::CorruptTree {
+                            which: Side::A,
+                            what: "a child past the node array",
+                        })?;
+                    let upper = here.map_or(f64::INFINITY, |(c, n)| {
+                        n.distance + (ball.centre - c).norm() + ball.radius
+                    });
+                    open.push(Open {
+                        upper,
+                        index: child,
+                        known: here,
+                    });
+                }
+            }
+        }
+    }
+    live.sort_unstable();
+    Ok((live, culled))
+}
+
+/// The farthest measured vertex from `to`: a lower bound on the distance.
+fn farthest(nearest: &[Option<Near>], vertices: &[Vector3<f64>], owner: &[u32]) -> Option<Witness> {
+    let mut witness: Option<Witness> = None;
+    for ((n, p), triangle) in nearest.iter().zip(vertices).zip(owner) {
+        if let Some(n) = n {
+            if witness.is_none_or(|w| n.distance > w.near.distance) {
+                witness = Some(Witness {
+                    point: *p,
+                    near: *n,
+                    triangle: *triangle,
+                });
+            }
+        }
+    }
+    witness
+}
+
 fn bound<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
-    triangles: &[([Vector3<f64>; 3], u32)],
+    from: &FromModel,
     options: &HausdorffOptions,
 ) -> Result<Local, QueryError> {
-    // Corners shared by triangles are measured once.
-    let mut index: HashMap<[u64; 3], usize> = HashMap::new();
-    let mut vertices: Vec<Vector3<f64>> = Vec::new();
-    let corners: Vec<[usize; 3]> = triangles
-        .iter()
-        .map(|(t, _)| {
-            t.map(|p| {
-                *index.entry(p.map(f64::to_bits).into()).or_insert_with(|| {
-                    vertices.push(p);
-                    vertices.len() - 1
-                })
-            })
-        })
-        .collect();
+    let vertices = &from.vertices;
+    // A vertex's witness triangle: the first face that has it.
+    let mut owner: Vec<u32> = vec![0; vertices.len()];
+    for (face, id) in from.faces.iter().zip(&from.ids).rev() {
+        for &v in face {
+            if let Some(o) = owner.get_mut(v) {
+                *o = *id;
+            }
+        }
+    }
     let (lo, hi) = vertices.iter().fold(
         (
             Vector3::repeat(f64::INFINITY),
@@ -417,63 +675,87 @@ fn bound<B: BoundingVolume>(
     // Distances between points of this magnitude are only known to a few ulps of it:
     // bounds that close to each other are exact to f64 rounding.
     let rounding = 8.0 * f64::EPSILON * lo.abs().sup(&hi.abs()).max();
-    // Every vertex, in runs seeded as closest points are.
-    let measured: Vec<Vec<(Near, Work)>> = vertices
-        .par_chunks(WARM_RUN)
-        .map_init(BinaryHeap::new, |heap, run| {
-            let mut seed = None;
-            run.iter()
-                .map(|p| {
-                    let mut work = Work::default();
-                    let n = near(tree, p, seed, heap, &mut work)?;
-                    seed = Some(n.face);
-                    Ok((n, work))
-                })
-                .collect::<Result<Vec<_>, QueryError>>()
-        })
-        .collect::<Result<_, QueryError>>()?;
+    let enough = |lower: f64| lower + (options.rel_err * lower).max(options.abs_err).max(rounding);
+    let no_triangles = QueryError::CorruptTree {
+        which: Side::A,
+        what: "a tree without triangles",
+    };
+    // A sample of the vertices first: its farthest lets whole nodes of `from` go unmeasured.
     let mut work = Work::default();
-    let mut nearest = Vec::with_capacity(vertices.len());
-    for (n, w) in measured.into_iter().flatten() {
-        work += w;
-        nearest.push(n);
-    }
-    // The farthest vertex is the first lower bound.
-    let mut witness: Option<Witness> = None;
-    for ((t, id), c) in triangles.iter().zip(&corners) {
-        for (k, &v) in c.iter().enumerate() {
-            if let (Some(n), Some(p)) = (nearest.get(v), t.get(k)) {
-                if witness.is_none_or(|w| n.distance > w.near.distance) {
-                    witness = Some(Witness {
-                        point: *p,
-                        near: *n,
-                        triangle: *id,
-                    });
+    let mut nearest: Vec<Option<Near>> = vec![None; vertices.len()];
+    // (In leaf order, where neighbours are near: each run's descents seed the next.)
+    let mut seen = vec![false; vertices.len()];
+    let in_leaf_order = from
+        .faces
+        .iter()
+        .flatten()
+        .filter(|&&v| match seen.get_mut(v) {
+            Some(s) if !*s => {
+                *s = true;
+                true
+            }
+            _ => false,
+        });
+    let sample: Vec<usize> = in_leaf_order.step_by(SAMPLE_STRIDE).copied().collect();
+    measure(tree, vertices, &sample, &mut nearest, &mut work)?;
+    let mut witness = farthest(&nearest, vertices, &owner).ok_or(no_triangles.clone())?;
+    let (live, culled) = cull(
+        tree,
+        from,
+        enough,
+        Measures {
+            nearest: &mut nearest,
+            witness: &mut witness,
+            owner: &owner,
+        },
+        &mut work,
+    )?;
+    // Then every vertex of the triangles kept.
+    let mut queued = vec![false; vertices.len()];
+    let mut rest = Vec::new();
+    for face in &live {
+        for &v in from.faces.get(*face as usize).into_iter().flatten() {
+            if nearest.get(v).is_some_and(Option::is_none)
+                && !queued.get(v).copied().unwrap_or(true)
+            {
+                if let Some(q) = queued.get_mut(v) {
+                    *q = true;
                 }
+                rest.push(v);
             }
         }
     }
-    let Some(mut witness) = witness else {
-        return Err(QueryError::CorruptTree {
-            which: Side::A,
-            what: "a tree without triangles",
-        });
-    };
-    let enough = |lower: f64| lower + (options.rel_err * lower).max(options.abs_err).max(rounding);
-    // Every triangle's bound; those that might raise the lower bound are refined.
+    measure(tree, vertices, &rest, &mut nearest, &mut work)?;
+    witness = farthest(&nearest, vertices, &owner).ok_or(no_triangles)?;
+    // Every kept triangle's bound; those that might raise the lower bound are refined.
     let first = enough(witness.near.distance);
-    let bounded: Vec<(Piece, Option<Measured>, Work)> = triangles
+    let bounded: Vec<(Piece, Option<Measured>, Work)> = live
         .par_iter()
-        .zip(&corners)
-        .map_init(BinaryHeap::new, |heap, ((t, id), c)| {
+        .map_init(BinaryHeap::new, |heap, &face| {
             let mut work = Work::default();
-            let [Some(n0), Some(n1), Some(n2)] = c.map(|v| nearest.get(v).copied()) else {
-                return Err(QueryError::CorruptTree {
-                    which: Side::A,
-                    what: "a corner without its distance",
-                });
+            let corner_lost = QueryError::CorruptTree {
+                which: Side::A,
+                what: "a corner without its distance",
             };
-            let (p, middle) = bounded_piece(tree, *t, [n0, n1, n2], *id, first, (heap, &mut work))?;
+            let (Some(c), Some(id)) = (from.faces.get(face as usize), from.ids.get(face as usize))
+            else {
+                return Err(corner_lost);
+            };
+            let [Some(p0), Some(p1), Some(p2)] = c.map(|v| vertices.get(v).copied()) else {
+                return Err(corner_lost);
+            };
+            let [Some(n0), Some(n1), Some(n2)] = c.map(|v| nearest.get(v).copied().flatten())
+            else {
+                return Err(corner_lost);
+            };
+            let (p, middle) = bounded_piece(
+                tree,
+                [p0, p1, p2],
+                [n0, n1, n2],
+                *id,
+                first,
+                (heap, &mut work),
+            )?;
             Ok((p, middle, work))
         })
         .collect::<Result<_, QueryError>>()?;
@@ -488,7 +770,7 @@ fn bound<B: BoundingVolume>(
             }
         }
     }
-    let mut upper: f64 = witness.near.distance;
+    let mut upper: f64 = witness.near.distance.max(culled);
     let mut heap = BinaryHeap::new();
     for (p, _, w) in bounded {
         work += w;

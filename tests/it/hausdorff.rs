@@ -190,8 +190,7 @@ fn meshes_match_brute_force_for_every_tree_type() {
     let rough = common::noisy(&sphere, 0.03, 5);
     let coarse = common::uv_sphere(1.05, 5, 7);
     let cow = common::cow();
-    // (Brute force samples the first model, and the second for a symmetric case: the cow,
-    // of thousands of triangles, is only ever the second of a one-sided case.)
+    // (Brute force samples the first model, and the second for a symmetric case.)
     let cases = [
         (
             "sphere/noisy copy",
@@ -216,6 +215,15 @@ fn meshes_match_brute_force_for_every_tree_type() {
             common::turned_pose(2, 0.3),
             Pose::identity(),
             false,
+        ),
+        // Far apart: most of A's nodes are culled unmeasured.
+        (
+            "cow/far coarse sphere",
+            &cow,
+            &coarse,
+            Pose::identity(),
+            Pose::translation(2.5, 0.8, -0.4),
+            true,
         ),
     ];
     let f64_tree = |mesh: &TriMesh| common::tree_f64(mesh);
@@ -328,4 +336,73 @@ fn the_cli_answers_as_the_library() {
     assert!(line["upper_bound"].as_f64().expect("a number") >= printed);
     let o = obbtree(&["hausdorff", &cow, &cow, "--rel-err", "-0.5"]);
     assert_bad_input(&o, "rel_err must be finite and at least 0, got -0.5");
+}
+
+/// The work of fixed Hausdorff queries on the cow, pinned as `work_pins.rs` pins the pair
+/// queries': `[D, I, triangle tests, nodes visited]`. The answers are checked above; this
+/// notices a lost cull of A's nodes, a looser bound or a changed refinement, which leave
+/// the answers alone. A deliberate change updates the table (the failure prints the new
+/// one) and says before and after in its commit message.
+#[test]
+fn work_is_pinned() {
+    let cow = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
+    let sphere = build(
+        &common::uv_sphere(0.2, 6, 8),
+        &BuildOptions::default(),
+        None,
+    )
+    .expect("builds");
+    let id = Pose::identity();
+    let cases: [(&str, &ObbtFile, Pose, &ObbtFile, f64); 4] = [
+        (
+            "cow/turned cow",
+            &cow,
+            common::turned_pose(3, 0.02),
+            &cow,
+            0.0,
+        ),
+        (
+            "cow/turned cow rel_err 0.01",
+            &cow,
+            common::turned_pose(3, 0.02),
+            &cow,
+            0.01,
+        ),
+        (
+            "cow/far sphere",
+            &cow,
+            Pose::translation(2.0, 0.5, 0.0),
+            &sphere,
+            0.0,
+        ),
+        ("sphere/cow", &sphere, id, &cow, 0.0),
+    ];
+    let pinned: [(&str, [u64; 4]); 4] = [
+        ("cow/turned cow", [19159, 26058, 3859, 44738]),
+        ("cow/turned cow rel_err 0.01", [15074, 20428, 3003, 34948]),
+        ("cow/far sphere", [5660, 9901, 2310, 15697]),
+        ("sphere/cow", [53704, 65674, 7722, 118660]),
+    ];
+    let measured: Vec<(&str, [u64; 4])> = cases
+        .iter()
+        .map(|(name, a, pose_a, b, rel_err)| {
+            let options = HausdorffOptions {
+                rel_err: *rel_err,
+                ..HausdorffOptions::default()
+            };
+            let w = hausdorff(a, pose_a, b, &id, &options)
+                .expect("answers")
+                .work;
+            (
+                *name,
+                [
+                    w.bv_disjoint,
+                    w.bv_overlap,
+                    w.tri_separated,
+                    w.nodes_visited,
+                ],
+            )
+        })
+        .collect();
+    assert_eq!(measured, pinned, "new table: {measured:#?}");
 }
