@@ -10,8 +10,11 @@
 //! cannot raise the best lower bound (within the error asked) are dropped; the others are
 //! split in four at their edges' midpoints, largest upper bound first. Where one triangle
 //! of B is nearest a whole piece the bounds meet, so most pieces end at once; where the
-//! farthest point sits on the boundary between two triangles' regions, the bounds close
-//! linearly with the piece's size and splitting stops at a floor, the gap left reported.
+//! farthest point sits on a ridge between two triangles' regions, the convexity bound
+//! closes only linearly with the piece's size; there a second bound, the distance to the
+//! nearest of the points of B measured ([`point_bound`]), closes quadratically, and
+//! splitting stops at a floor where the peak of that bound is measured, the gap left
+//! reported.
 //!
 //! Before any piece, A's own tree culls: a sample of A's vertices gives a first lower
 //! bound, and a node whose ball (centre's distance to B plus radius) cannot exceed it is
@@ -85,9 +88,10 @@ pub struct HausdorffResult {
 }
 
 /// Pieces are not split below this fraction of their model's bounding-box diagonal: there
-/// the bounds of a piece on a boundary between two triangles' regions are as close as
-/// splitting can make them in reasonable time.
-const FLOOR: f64 = 1.0 / (1u64 << 24) as f64;
+/// the bounds of a piece on a ridge between two triangles' regions are about its square
+/// apart, and a ridge across the model costs about a million descents. (At 2⁻²⁴ a fuzzed
+/// ridge of a few triangles took half a minute.)
+const FLOOR: f64 = 1.0 / (1u64 << 16) as f64;
 
 /// The Hausdorff distance from `a` posed by `pose_a` to `b` posed by `pose_b` (world
 /// frame): the largest distance from a point of A's surface to B's, with the point where
@@ -389,6 +393,85 @@ fn upper_bound<B: BoundingVolume>(
     Ok(best)
 }
 
+/// The nearest-points bound of a piece: no point `x` of it is farther from B than from the
+/// nearest of the points `q` of B measured (`d(x, B) <= min_i |x - q_i|`), and that
+/// envelope's largest value over the piece is found exactly. Over the part of the piece
+/// nearest one `q_i` the envelope is that point's distance, convex, so it peaks at a vertex
+/// of that part: a corner of the piece, where an edge crosses the bisector of two points,
+/// or where the bisectors of three points cross the piece's plane. Where the nearest
+/// triangle of B changes inside the piece, the convexity bound closes only linearly with
+/// the piece's size and this one quadratically: a point moved by `s` along a face of B
+/// gets farther from the measured point by about `s² / 2d`, not `s`. Also returns where
+/// the envelope peaks: near where the true distance peaks, a good point to measure.
+fn point_bound(corners: &[Vector3<f64>; 3], points: &[Vector3<f64>]) -> (f64, Vector3<f64>) {
+    let envelope = |x: &Vector3<f64>| {
+        points
+            .iter()
+            .map(|q| (x - q).norm())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut best = (envelope(&corners[0]), corners[0]);
+    let mut offer = |x: Vector3<f64>| {
+        let e = envelope(&x);
+        if e > best.0 {
+            best = (e, x);
+        }
+    };
+    offer(corners[1]);
+    offer(corners[2]);
+    let pairs = || (0..points.len()).flat_map(move |i| (i + 1..points.len()).map(move |j| (i, j)));
+    // The bisector of `q_i` and `q_j`: the plane through their middle across `q_j - q_i`.
+    let bisector = |i: usize, j: usize| {
+        let (qi, qj) = (points.get(i)?, points.get(j)?);
+        Some(((qi + qj) / 2.0, qj - qi))
+    };
+    for k in 0..3 {
+        let (Some(a), Some(b)) = (corners.get(k), corners.get((k + 1) % 3)) else {
+            continue;
+        };
+        for (i, j) in pairs() {
+            let Some((m, w)) = bisector(i, j) else {
+                continue;
+            };
+            let along = (b - a).dot(&w);
+            if along != 0.0 {
+                let t = (m - a).dot(&w) / along;
+                if (0.0..=1.0).contains(&t) {
+                    offer(a + (b - a) * t);
+                }
+            }
+        }
+    }
+    let [c0, c1, c2] = corners;
+    let normal = (c1 - c0).cross(&(c2 - c0));
+    if normal != Vector3::zeros() {
+        for (i, j) in pairs() {
+            for k in j + 1..points.len() {
+                let (Some((m1, w1)), Some((m2, w2))) = (bisector(i, j), bisector(i, k)) else {
+                    continue;
+                };
+                let rows = nalgebra::Matrix3::from_rows(&[
+                    w1.transpose(),
+                    w2.transpose(),
+                    normal.transpose(),
+                ]);
+                let rhs = Vector3::new(m1.dot(&w1), m2.dot(&w2), c0.dot(&normal));
+                let Some(x) = rows.lu().solve(&rhs) else {
+                    continue;
+                };
+                // Inside the piece: on the inner side of each edge (barycentric signs).
+                let inside = [(c0, c1), (c1, c2), (c2, c0)]
+                    .iter()
+                    .all(|&(p, q)| (q - p).cross(&(x - p)).dot(&normal) >= 0.0);
+                if inside {
+                    offer(x);
+                }
+            }
+        }
+    }
+    best
+}
+
 /// A piece's bound, and its centroid with what is nearest it when the corners' candidates
 /// alone leave the bound above `threshold`: the triangle nearest the middle often bounds a
 /// piece whose corners each see another (a corner of A shared by several triangles of B).
@@ -400,7 +483,9 @@ fn bounded_piece<B: BoundingVolume>(
     threshold: f64,
     (heap, work): (&mut BinaryHeap<Waiting>, &mut Work),
 ) -> Result<(Piece, Option<Measured>), QueryError> {
-    let mut upper = upper_bound(tree, &corners, &near, work)?;
+    let nearest = near.map(|n| n.point);
+    let mut upper =
+        upper_bound(tree, &corners, &near, work)?.min(point_bound(&corners, &nearest).0);
     let mut middle = None;
     if upper > threshold {
         let c = (corners[0] + corners[1] + corners[2]) / 3.0;
@@ -409,6 +494,8 @@ fn bounded_piece<B: BoundingVolume>(
         if near.iter().all(|m| m.face != n.face) {
             upper = upper.min(candidate_bound(tree, &corners, &near, n.face, work)?);
         }
+        let [q0, q1, q2] = nearest;
+        upper = upper.min(point_bound(&corners, &[q0, q1, q2, n.point]).0);
         middle = Some((c, n));
     }
     let piece = Piece {
@@ -790,6 +877,24 @@ fn bound<B: BoundingVolume>(
         let [p0, p1, p2] = piece.corners;
         let longest = (p1 - p0).norm().max((p2 - p1).norm()).max((p0 - p2).norm());
         if longest <= floor {
+            // Split no further; where the nearest-points bound peaks is where the distance
+            // most likely does (across a ridge between two triangles' regions of B, the
+            // corners and middles sampled so far fall short of it linearly).
+            let (_, peak) = point_bound(&piece.corners, &piece.near.map(|n| n.point));
+            let n = near(
+                tree,
+                &peak,
+                Some(piece.near[0].face),
+                &mut scratch,
+                &mut work,
+            )?;
+            if n.distance > witness.near.distance {
+                witness = Witness {
+                    point: peak,
+                    near: n,
+                    triangle: piece.triangle,
+                };
+            }
             upper = upper.max(piece.upper);
             continue;
         }
