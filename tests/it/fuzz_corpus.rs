@@ -11,6 +11,11 @@
 #[path = "../../fuzz/harness.rs"]
 mod harness;
 
+// The differential harness brings its own copy of `common::oracle`, for the same reason.
+#[allow(clippy::duplicate_mod)]
+#[path = "../../fuzz/differential.rs"]
+mod differential;
+
 use std::path::{Path, PathBuf};
 
 /// The regular files of `dir` (skipping dot files), sorted; empty if `dir` does not exist.
@@ -62,4 +67,9 @@ fn obj_loader_corpus() {
 #[test]
 fn stl_loader_corpus() {
     replay("stl_loader", harness::stl_loader);
+}
+
+#[test]
+fn differential_corpus() {
+    replay("differential", differential::differential);
 }
