@@ -373,8 +373,13 @@ fn ray_queries(a: &ObbtFile, pose: &Pose, ta: &[Triangle], rays: &[Ray]) {
     }
 }
 
+/// The Hausdorff error asked: exact answers on a ridge between two triangles' regions
+/// cost seconds (pieces split to the floor all along it), which would starve the fuzzer;
+/// `tests/it/hausdorff.rs` holds the exact ones to brute force.
+const HAUSDORFF_REL_ERR: f64 = 1e-6;
+
 /// The one-sided Hausdorff distance: at least every vertex's distance, at most its bound
-/// over samples of A, the witness at the distance it claims.
+/// over samples of A, the witness at the distance it claims, the bounds within the error.
 fn hausdorff_query(
     a: &ObbtFile,
     pose_a: &Pose,
@@ -383,7 +388,11 @@ fn hausdorff_query(
     (world_a, world_b): (&[Triangle], &[Triangle]),
     eps: f64,
 ) {
-    let h = hausdorff(a, pose_a, b, pose_b, &HausdorffOptions::default()).expect("measures");
+    let options = HausdorffOptions {
+        rel_err: HAUSDORFF_REL_ERR,
+        ..HausdorffOptions::default()
+    };
+    let h = hausdorff(a, pose_a, b, pose_b, &options).expect("measures");
     assert!(h.distance <= h.upper_bound, "{h:?}");
     let witness = point_distance(&Vector3::from(h.point_a), world_b);
     assert!(
@@ -391,7 +400,6 @@ fn hausdorff_query(
         "witness at {witness}, claimed {}",
         h.distance
     );
-    let mut largest: f64 = 0.0;
     for t in world_a {
         let [p, q, r] = *t;
         for s in [
@@ -404,7 +412,6 @@ fn hausdorff_query(
             (p + q + r) / 3.0,
         ] {
             let d = point_distance(&s, world_b);
-            largest = largest.max(d);
             assert!(d <= h.upper_bound + eps, "a point of A at {d}, above {h:?}");
         }
     }
@@ -418,10 +425,8 @@ fn hausdorff_query(
         "h {} below a corner at {corners}",
         h.distance
     );
-    // Splitting stops at 2^-16 of A's size: on a ridge the bounds may stay apart by
-    // about its square.
     assert!(
-        h.upper_bound <= largest.max(h.distance) + 1e-5 * 64.0 + eps,
-        "{h:?}"
+        h.upper_bound <= h.distance * (1.0 + HAUSDORFF_REL_ERR) + eps,
+        "bounds further apart than asked: {h:?}"
     );
 }

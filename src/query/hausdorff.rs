@@ -319,8 +319,8 @@ fn near<B: BoundingVolume>(
     })
 }
 
-/// A point of `from`'s surface measured on the way (a piece's centroid), and what is
-/// nearest it.
+/// A point of `from`'s surface measured on the way (inside a piece), and what is nearest
+/// it.
 type Measured = (Vector3<f64>, Near);
 
 /// A piece of a triangle of `from`: its corners (`to`'s frame) with what is nearest each,
@@ -472,9 +472,11 @@ fn point_bound(corners: &[Vector3<f64>; 3], points: &[Vector3<f64>]) -> (f64, Ve
     best
 }
 
-/// A piece's bound, and its centroid with what is nearest it when the corners' candidates
-/// alone leave the bound above `threshold`: the triangle nearest the middle often bounds a
-/// piece whose corners each see another (a corner of A shared by several triangles of B).
+/// A piece's bound, and the farthest of the points measured inside it with what is nearest
+/// it. When the corners' candidates alone leave the bound above `threshold`, its centroid
+/// is measured (the triangle nearest the middle often bounds a piece whose corners each see
+/// another: a corner of A shared by several triangles of B), and then, if still above, the
+/// peak of the nearest-points bound.
 fn bounded_piece<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     corners: [Vector3<f64>; 3],
@@ -495,8 +497,22 @@ fn bounded_piece<B: BoundingVolume>(
             upper = upper.min(candidate_bound(tree, &corners, &near, n.face, work)?);
         }
         let [q0, q1, q2] = nearest;
-        upper = upper.min(point_bound(&corners, &[q0, q1, q2, n.point]).0);
+        let (bound, peak) = point_bound(&corners, &[q0, q1, q2, n.point]);
+        upper = upper.min(bound);
         middle = Some((c, n));
+        if upper > threshold {
+            // Where the nearest-points bound peaks, the distance most likely does: across a
+            // ridge between two triangles' regions of B, corners and middles fall short of
+            // it linearly with the piece's size, that point quadratically.
+            let m = self::near(tree, &peak, Some(n.face), heap, work)?;
+            if near.iter().all(|x| x.face != m.face) && m.face != n.face {
+                upper = upper.min(candidate_bound(tree, &corners, &near, m.face, work)?);
+            }
+            upper = upper.min(point_bound(&corners, &[q0, q1, q2, n.point, m.point]).0);
+            if m.distance > n.distance {
+                middle = Some((peak, m));
+            }
+        }
     }
     let piece = Piece {
         upper,

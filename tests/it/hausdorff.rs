@@ -381,7 +381,7 @@ fn work_is_pinned() {
         ("cow/turned cow", [19159, 26058, 3859, 44738]),
         ("cow/turned cow rel_err 0.01", [15074, 20428, 3003, 34948]),
         ("cow/far sphere", [5660, 9901, 2310, 15697]),
-        ("sphere/cow", [15153, 18377, 2632, 32981]),
+        ("sphere/cow", [15938, 19369, 2717, 34707]),
     ];
     let measured: Vec<(&str, [u64; 4])> = cases
         .iter()
@@ -405,4 +405,67 @@ fn work_is_pinned() {
         })
         .collect();
     assert_eq!(measured, pinned, "new table: {measured:#?}");
+}
+
+/// A flat A above a V-shaped valley B: every point of A over the valley's floor line is
+/// equally far from both faces, and farther than any other, so h lies all along a ridge
+/// between the two faces' regions, across A's triangles. The exact answer is the closed
+/// form to 1e-9 with its bound as close; the work is pinned (the floor and the
+/// nearest-points bound decide it: at the old floor of 2^-24 a ridge of this kind took
+/// half a minute), and an error allowance costs a small share of it.
+#[test]
+fn a_ridge_between_two_faces_is_bounded_quadratically() {
+    let k = 0.5;
+    let valley = TriMesh::new(
+        vec![
+            [0.0, -3.0, 0.0],
+            [0.0, 3.0, 0.0],
+            [3.0, -3.0, 3.0 * k],
+            [3.0, 3.0, 3.0 * k],
+            [-3.0, -3.0, 3.0 * k],
+            [-3.0, 3.0, 3.0 * k],
+        ],
+        vec![[0, 2, 3], [0, 3, 1], [0, 1, 5], [0, 5, 4]],
+    )
+    .expect("a valley");
+    // The floor line x = 0 crosses both triangles of the square inside.
+    let flat = TriMesh::new(
+        vec![
+            [-1.0, -1.0, 1.0],
+            [1.3, -1.0, 1.0],
+            [1.3, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .expect("a square");
+    let (a, b) = (
+        build(&flat, &BuildOptions::default(), None).expect("builds"),
+        build(&valley, &BuildOptions::default(), None).expect("builds"),
+    );
+    let id = Pose::identity();
+    let closed_form = 1.0 / (1.0 + k * k).sqrt();
+    let exact = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
+    assert!((exact.distance - closed_form).abs() <= 1e-9, "{exact:?}");
+    assert!(exact.upper_bound - exact.distance <= 1e-9, "{exact:?}");
+    assert!(
+        exact.point_a[0].abs() <= 1e-4,
+        "the witness is off the ridge: {exact:?}"
+    );
+    let loose = HausdorffOptions {
+        rel_err: 1e-6,
+        ..HausdorffOptions::default()
+    };
+    let approximate = hausdorff(&a, &id, &b, &id, &loose).expect("answers");
+    assert!(
+        approximate.upper_bound >= closed_form - 1e-12,
+        "{approximate:?}"
+    );
+    assert!(
+        approximate.work.nodes_visited * 20 < exact.work.nodes_visited,
+        "{:?} vs {:?}",
+        approximate.work,
+        exact.work
+    );
+    assert_eq!(exact.work.nodes_visited, 6_486_474, "{:?}", exact.work);
 }
