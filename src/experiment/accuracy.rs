@@ -1,6 +1,6 @@
 //! What accuracy and size cost in time: the choices that trade one for the other (the
-//! distance error allowed, tolerance queries, f32 or f64 storage, the fit, the leaf size,
-//! the compact layout), each measured by the time it takes, the error it actually incurs
+//! distance and Hausdorff error allowed, tolerance queries, f32 or f64 storage, the fit,
+//! the leaf size, the compact layout), each measured by the time it takes, the error it actually incurs
 //! against an exact f64 reference and the bytes its trees take, on the sliding spheres and
 //! on any mesh against a turned copy of itself.
 //!
@@ -17,7 +17,8 @@ use crate::format::ObbtFile;
 use crate::generate::{lat_long_sphere, PosePair, Rng};
 use crate::mesh::TriMesh;
 use crate::query::{
-    CollideOptions, DistanceOptions, PairQuery, Pose, QueryError, ToleranceOptions,
+    hausdorff, CollideOptions, DistanceOptions, HausdorffOptions, PairQuery, Pose, QueryError,
+    ToleranceOptions,
 };
 use crate::real::Precision;
 use nalgebra::Vector3;
@@ -34,7 +35,7 @@ pub struct Workload {
     pub b: TriMesh,
     /// Poses where the models are apart (distance queries).
     pub apart: Vec<PosePair>,
-    /// Poses where they cross (collision queries).
+    /// Poses where they cross (collision and Hausdorff queries).
     pub crossing: Vec<PosePair>,
 }
 
@@ -96,15 +97,15 @@ pub fn turned_copy(name: &str, mesh: &TriMesh, seed: u64) -> Workload {
 pub struct Trade {
     /// The scene's name.
     pub scene: String,
-    /// `distance` or `collision`.
+    /// `distance`, `collision` or `hausdorff`.
     pub query: &'static str,
     /// The choice, as the command line spells it (`f32, --rel-err 0.01`).
     pub choice: String,
     /// Seconds for the scene's poses: the sum over poses of each pose's median time.
     pub seconds: f64,
-    /// The error incurred, mean over the poses: for distance the relative excess over the
-    /// exact f64 distance, for collision the share of contacting pairs that differ from
-    /// the exact f64 answer (gained or lost).
+    /// The error incurred, mean over the poses: for distance and Hausdorff distance the
+    /// relative difference from the exact f64 answer, for collision the share of contacting
+    /// pairs that differ from the exact f64 answer (gained or lost).
     pub error_mean: f64,
     /// The largest error over the poses.
     pub error_max: f64,
@@ -112,8 +113,9 @@ pub struct Trade {
     pub bv_tests: f64,
     /// The bytes of both models' tree files per triangle they hold.
     pub bytes_per_triangle: f64,
-    /// Whether the exact answer was asked for (every collision; a distance without an
-    /// error allowance or tolerance): what differs between such trades is the tree.
+    /// Whether the exact answer was asked for (every collision; a distance or Hausdorff
+    /// distance without an error allowance or tolerance): what differs between such trades
+    /// is the tree.
     pub exact: bool,
     /// Whether no other choice of the same scene and query is at least as fast and at
     /// least as accurate (by the largest error), and better in one.
@@ -276,17 +278,28 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
         let r = pair.collide(pa, pb, &CollideOptions::default())?;
         contacts.push(r.pairs.into_iter().collect::<BTreeSet<_>>());
     }
+    let mut hausdorffs = Vec::new();
+    for [pa, pb] in &scene.crossing {
+        let h = hausdorff(
+            &reference.0,
+            pa,
+            &reference.1,
+            pb,
+            &HausdorffOptions::default(),
+        )?;
+        hausdorffs.push(h.distance);
+    }
     let mut out = Vec::new();
     for choice in tree_choices() {
         let (a, b) = trees(scene, choice)?;
         let bytes_per_triangle = (a.info().file_bytes + b.info().file_bytes) as f64
             / (f64::from(a.info().triangles) + f64::from(b.info().triangles));
         let mut pair = PairQuery::new(&a, &b)?;
-        let asks: &[Ask] = if matches!(choice.precision, Precision::F32)
+        let default_tree = matches!(choice.precision, Precision::F32)
             && choice.layout == Layout::Fast
             && choice.fit == FitMethod::Hull
-            && choice.leaf_size == 1
-        {
+            && choice.leaf_size == 1;
+        let asks: &[Ask] = if default_tree {
             &ASKS
         } else {
             &[Ask::RelErr(0.0)]
@@ -325,8 +338,8 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
             finish(&mut trade, scene.apart.len());
             out.push(trade);
         }
-        let choice = choice.flags().join(", ");
-        let mut trade = Trade::new(&scene.name, "collision", choice, bytes_per_triangle);
+        let label = choice.flags().join(", ");
+        let mut trade = Trade::new(&scene.name, "collision", label, bytes_per_triangle);
         for ([pa, pb], expected) in scene.crossing.iter().zip(&contacts) {
             let ((found, tests), seconds) = median_time(repeat, || -> Result<_, QueryError> {
                 let r = pair.collide(pa, pb, &CollideOptions::default())?;
@@ -341,6 +354,37 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
         }
         finish(&mut trade, scene.crossing.len());
         out.push(trade);
+        for rel_err in asks.iter().filter_map(|ask| match ask {
+            Ask::RelErr(r) => Some(*r),
+            Ask::Tolerance(_) => None,
+        }) {
+            let flags = [choice.flags(), vec![Ask::RelErr(rel_err).flag()]].concat();
+            let mut trade = Trade::new(
+                &scene.name,
+                "hausdorff",
+                flags.join(", "),
+                bytes_per_triangle,
+            );
+            trade.exact = rel_err == 0.0;
+            let options = HausdorffOptions {
+                rel_err,
+                ..HausdorffOptions::default()
+            };
+            for ([pa, pb], &h) in scene.crossing.iter().zip(&hausdorffs) {
+                let ((found, tests), seconds) = median_time(repeat, || {
+                    let r = hausdorff(&a, pa, &b, pb, &options)?;
+                    Ok::<_, QueryError>((r.distance, r.work.bv_tests()))
+                })?;
+                let error = if h > 0.0 {
+                    (found - h).abs() / h
+                } else {
+                    found.abs()
+                };
+                add(&mut trade, seconds, error, tests);
+            }
+            finish(&mut trade, scene.crossing.len());
+            out.push(trade);
+        }
     }
     Ok(out)
 }

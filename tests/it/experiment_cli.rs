@@ -493,9 +493,10 @@ fn quick_transverse_contact_grows_as_the_square_root_of_the_tessellation() {
     }
 }
 
-/// The accuracy experiment on the sliding spheres and the bundled cow: every answer is
-/// within what its choice promises against the exact f64 answer, the f64 tree's answers
-/// are the reference itself, and the Pareto marks are the undominated choices.
+/// The accuracy experiment on the sliding spheres and the bundled cow (distance, collision
+/// and Hausdorff distance): every answer is within what its choice promises against the
+/// exact f64 answer, the f64 tree's answers are the reference itself, and the Pareto marks
+/// are the undominated choices.
 #[test]
 fn quick_accuracy_keeps_every_choice_within_its_promise() {
     let dir = scratch("experiment-accuracy");
@@ -555,6 +556,18 @@ fn quick_accuracy_keeps_every_choice_within_its_promise() {
     assert!(dir.join("accuracy-size.svg").exists());
     let scenes: std::collections::BTreeSet<&str> = trades.iter().map(|t| t.0.as_str()).collect();
     assert_eq!(scenes.into_iter().collect::<Vec<_>>(), ["cow", "spheres"]);
+    // Every query has its rows on every scene, the Hausdorff distance at each error asked.
+    for scene in ["cow", "spheres"] {
+        let rows = |query: &str| {
+            trades
+                .iter()
+                .filter(|t| t.0 == scene && t.1 == query)
+                .count()
+        };
+        assert!(rows("distance") > 0 && rows("collision") > 0, "{scene}");
+        assert_eq!(rows("hausdorff"), 12, "{scene}: 6 errors and 6 other trees");
+    }
+    assert!(dir.join("accuracy-hausdorff.svg").exists());
     // f32 coordinates are within 6e-8 of the f64 ones: distances move by about that.
     let storage = 1e-5;
     for (scene, query, choice, _, error_max, _) in &trades {

@@ -341,7 +341,7 @@ pub struct TradeChart {
 }
 
 /// The accuracy experiment's charts, one per query.
-pub const TRADE_CHARTS: [TradeChart; 2] = [
+pub const TRADE_CHARTS: [TradeChart; 3] = [
     TradeChart {
         query: "distance",
         title: "Distance: time against the error incurred (exact at 1e-16)",
@@ -351,6 +351,11 @@ pub const TRADE_CHARTS: [TradeChart; 2] = [
         query: "collision",
         title: "Collision: time against the contacts missed or added (exact at 1e-16)",
         x_label: "largest share of contacting pairs differing",
+    },
+    TradeChart {
+        query: "hausdorff",
+        title: "Hausdorff distance: time against the error incurred (exact at 1e-16)",
+        x_label: "largest relative error over the poses",
     },
 ];
 
