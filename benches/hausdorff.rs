@@ -2,8 +2,8 @@
 //! `Polygon_mesh_processing::bounded_error_Hausdorff_distance` and dense point sampling
 //! (MeshLab's method, as CGAL's `approximate_Hausdorff_distance`) in one run, one thread.
 //!
-//! The peer is the harness `../shared/peers/cgal-hausdorff/build.sh` (Debian's
-//! libcgal-dev), built outside the repository; this benchmark looks for
+//! The peer is the harness in `benches/harnesses/cgal-hausdorff/` (Debian's libcgal-dev),
+//! built outside the repository by its `build.sh`; this benchmark looks for
 //! `bench_cgal_hausdorff` in `$OBBTREE_PEERS` (default `/tmp/peers`) and prints obbtree's
 //! figures alone without it. Cases (meshes from `../shared/meshes`, skipped without them):
 //! a mesh against a noisy copy (every vertex moved by up to 10⁻³ of the diagonal), against
@@ -61,7 +61,7 @@ fn main() {
         PathBuf::from(std::env::var("OBBTREE_PEERS").unwrap_or_else(|_| "/tmp/peers".into()));
     if !peers.join("bench_cgal_hausdorff").exists() {
         eprintln!(
-            "bench_cgal_hausdorff not found in {}: build it with ../shared/peers/cgal-hausdorff/build.sh; obbtree alone follows",
+            "bench_cgal_hausdorff not found in {}: build it with benches/harnesses/cgal-hausdorff/build.sh; obbtree alone follows",
             peers.display()
         );
     }
