@@ -20,7 +20,7 @@ pub enum FormatError {
     #[error("not an .obbt file: bad signature at byte 0")]
     BadSignature,
     /// A major version this reader does not implement.
-    #[error("unsupported format version {major}.{minor} (this reader reads version 1.x)")]
+    #[error("unsupported format version {major}.{minor}: this reader reads version 1.x; rebuild the file from its mesh with this obbtree (`obbtree build`), or read it with the obbtree that wrote it")]
     UnsupportedVersion {
         /// Major version found.
         major: u16,

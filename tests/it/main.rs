@@ -22,6 +22,7 @@ mod experiment_cli;
 mod far_apart;
 mod fit;
 mod fuzz_corpus;
+mod golden;
 mod hard_cases;
 mod hausdorff;
 mod hostile_cli;
