@@ -298,3 +298,21 @@ fn a_coherent_sweep_is_warm_started_from_the_previous_answer() {
         "warm {warm_bv} volumes, {warm_tri} triangles; alone {alone_bv}, {alone_tri}"
     );
 }
+
+/// A sliver found by the differential fuzzer: Ericson's region tests cancel on it, and
+/// picked the face at a point 0.056 farther than the nearest of its edges. The answer must
+/// be as near as the reference's (computed another way), in both frames it was met in.
+#[test]
+fn a_sliver_gets_its_nearest_point() {
+    use obbtree::query::triangle::closest_point_on_triangle;
+    let t = [
+        [5.813213737593799, 1.8982047865648, 0.4671715113867928],
+        [5.915062363271039, 1.9403918686293735, 0.40824691928354306],
+        [1.841117336181433, 0.2529085860464335, 2.7652306034135323],
+    ];
+    let p = Vector3::new(3.5, 0.875, 0.0);
+    let (q, _) = closest_point_on_triangle(&p, &t.map(Vector3::from));
+    let reference = point_triangle_distance(&p, &t);
+    assert!((reference - 1.6051518805091713).abs() < 1e-9, "{reference}");
+    assert!(((p - q).norm() - reference).abs() < 1e-12, "{q:?}");
+}

@@ -35,8 +35,10 @@ impl Feature {
 
 /// The point of triangle `t` closest to `p`, and the feature it lies on: by the Voronoi
 /// regions of the corners, then of the edges, then the face (Ericson, *Real-Time Collision
-/// Detection* §5.1.5). A zero-area triangle is the segment or point it spans: its closest
-/// point is the nearest of its edges'. Never NaN for finite input.
+/// Detection* §5.1.5). Where those tests cancel (a sliver: rounding could pick the wrong
+/// region, and a face point farther than an edge's), and for a zero-area triangle (the
+/// segment or point it spans), the nearest of its edges' closest points and its plane's
+/// projection if inside. Never NaN for finite input.
 pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
     let [a, b, c] = t;
     let (ab, ac, ap) = (b - a, c - a, p - a);
@@ -49,20 +51,30 @@ pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64
     if d3 >= 0.0 && d4 <= d3 {
         return (*b, Feature::Vertex(1));
     }
-    let vc = d1 * d4 - d3 * d2;
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    let (vc, vb, va) = (d1 * d4 - d3 * d2, d5 * d2 - d1 * d6, d3 * d6 - d5 * d4);
+    // The region tests subtract products of nearly equal size on a sliver: when what is
+    // left is small against them (about 2^-20), rounding can pick a wrong region, and the
+    // nearest of the edges and the face is taken instead.
+    let size = (d1 * d4).abs()
+        + (d3 * d2).abs()
+        + (d5 * d2).abs()
+        + (d1 * d6).abs()
+        + (d3 * d6).abs()
+        + (d5 * d4).abs();
+    if (va + vb + vc) * ILL_CONDITIONED < size {
+        return nearest_of_edges_and_face(p, t);
+    }
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0 {
         return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
     }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
     if d6 >= 0.0 && d5 <= d6 {
         return (*c, Feature::Vertex(2));
     }
-    let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0 {
         return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
     }
-    let va = d3 * d6 - d5 * d4;
     let (e4, e5) = (d4 - d3, d5 - d6);
     if va <= 0.0 && e4 >= 0.0 && e5 >= 0.0 && e4 + e5 > 0.0 {
         return (b + (c - b) * (e4 / (e4 + e5)), Feature::Edge(1));
@@ -72,8 +84,30 @@ pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64
         let (v, w) = (vb / sum, vc / sum);
         return (a + ab * v + ac * w, Feature::Face);
     }
-    // A zero-area triangle (or one so thin that rounding left no region): its edges.
+    nearest_of_edges_and_face(p, t)
+}
+
+/// Where [`closest_point_on_triangle`]'s region tests cancel: `size / sum` of their
+/// products above this is a sliver whose regions rounding may confuse.
+const ILL_CONDITIONED: f64 = (1u64 << 20) as f64;
+
+/// The nearest of the three edges' closest points and, if it falls inside, the projection
+/// on the plane: correct whatever the shape, at the cost of every candidate. A zero-area
+/// triangle is the segment or point it spans (no plane).
+fn nearest_of_edges_and_face(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
+    let [a, b, c] = t;
     let mut best = (*a, Feature::Vertex(0), f64::INFINITY);
+    let n = (b - a).cross(&(c - a));
+    let n2 = n.norm_squared();
+    if n2 > 0.0 && n2.is_finite() {
+        let q = p - n * (n.dot(&(p - a)) / n2);
+        let inside = [(a, b), (b, c), (c, a)]
+            .iter()
+            .all(|&(s, e)| (e - s).cross(&(q - s)).dot(&n) >= 0.0);
+        if inside {
+            best = (q, Feature::Face, (p - q).norm_squared());
+        }
+    }
     for (k, (s, e)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
         // `k` is 0, 1 or 2.
         let (q, feature) = closest_on_segment(p, s, e, k as u8);
