@@ -39,9 +39,10 @@ use std::collections::BinaryHeap;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HausdorffOptions {
     /// Relative error allowed (`>= 0`): the answer `h` and the true `h*` satisfy
-    /// `h <= h* <= h (1 + rel_err)` (or within `abs_err`, whichever is larger). With both
-    /// 0 (the default) the answer is exact to f64 rounding, but see
-    /// [`HausdorffResult::upper_bound`].
+    /// `h <= h* <= h (1 + rel_err)` (or within `abs_err`, whichever is larger), unless the
+    /// splitting reaches its floor first (a ridge between two triangles' regions of B):
+    /// [`HausdorffResult::upper_bound`] is always what is proven. With both 0 (the
+    /// default) the answer is exact to f64 rounding, up to that floor.
     pub rel_err: f64,
     /// Absolute error allowed (`>= 0`, world units).
     pub abs_err: f64,

@@ -84,8 +84,8 @@ fn answers(file: &ObbtFile) -> Value {
     )
     .expect("answers")[0]
         .value;
-    let h = hausdorff(file, &id, file, &crossing(), &HausdorffOptions::default())
-        .expect("measures");
+    let h =
+        hausdorff(file, &id, file, &crossing(), &HausdorffOptions::default()).expect("measures");
     let w = distance.closest.expect("a closest pair");
     json!({
         "version": format!("{}.{}", info.version.0, info.version.1),
@@ -108,7 +108,10 @@ fn answers(file: &ObbtFile) -> Value {
 fn same(found: &Value, recorded: &Value) -> bool {
     match (found, recorded) {
         (Value::Number(x), Value::Number(y)) if x.is_f64() || y.is_f64() => {
-            let (x, y) = (x.as_f64().unwrap_or(f64::NAN), y.as_f64().unwrap_or(f64::NAN));
+            let (x, y) = (
+                x.as_f64().unwrap_or(f64::NAN),
+                y.as_f64().unwrap_or(f64::NAN),
+            );
             (x - y).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0)
         }
         (Value::Array(x), Value::Array(y)) => {
@@ -184,7 +187,10 @@ fn a_later_major_version_is_refused_saying_what_to_do() {
     seal(&mut later);
     let error = ObbtFile::from_aligned(AlignedBytes::copy_from(&later)).expect_err("refused");
     assert!(
-        matches!(error, FormatError::UnsupportedVersion { major: 2, minor: 0 }),
+        matches!(
+            error,
+            FormatError::UnsupportedVersion { major: 2, minor: 0 }
+        ),
         "{error}"
     );
     let message = error.to_string();
