@@ -586,6 +586,7 @@ pub fn hausdorff(args: &HausdorffArgs) -> Result<(), Failure> {
         rel_err: args.rel_err,
         abs_err: args.abs_err,
         symmetric: args.symmetric,
+        warm_start: None,
     };
     let columns = csv_columns(&[
         "/hausdorff",

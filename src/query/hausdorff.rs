@@ -48,6 +48,23 @@ pub struct HausdorffOptions {
     pub abs_err: f64,
     /// Also measure h(B, A) and answer the larger: the symmetric Hausdorff distance.
     pub symmetric: bool,
+    /// Where an earlier query of the same two trees was answered
+    /// ([`HausdorffResult::warm_start`]): measured first, it bounds h from below from the
+    /// start, so that more of the measured model is culled at once when the poses moved
+    /// little. It changes the work, never the answer's guarantee.
+    pub warm_start: Option<HausdorffWarmStart>,
+}
+
+/// The witness of a Hausdorff answer in its own model's frame, to start the next query of
+/// the same two trees from ([`HausdorffOptions::warm_start`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HausdorffWarmStart {
+    /// Which one-sided distance the witness was for.
+    pub direction: HausdorffDirection,
+    /// The witness, in its model's frame (A's for [`HausdorffDirection::AToB`], else B's).
+    pub point: [f64; 3],
+    /// Input-mesh id of the witness's triangle.
+    pub triangle: u32,
 }
 
 /// Which one-sided distance a [`HausdorffResult`] is.
@@ -82,6 +99,8 @@ pub struct HausdorffResult {
     pub tri_a: u32,
     /// Input-mesh id of B's triangle holding `point_b`.
     pub tri_b: u32,
+    /// The witness in its model's frame, for [`HausdorffOptions::warm_start`].
+    pub warm_start: HausdorffWarmStart,
     /// Work done: the closest-point descents' volume and triangle tests, plus the
     /// triangle tests of the upper bounds; `nodes_visited` also counts A's nodes examined
     /// for culling and the pieces split.
@@ -134,7 +153,20 @@ pub fn hausdorff(
             });
         }
     }
-    let ab = one_sided(a, pose_a, b, pose_b, options)?;
+    let seed = |direction| {
+        options
+            .warm_start
+            .filter(|w| w.direction == direction)
+            .map(|w| (w.point, w.triangle))
+    };
+    let ab = one_sided(
+        a,
+        pose_a,
+        b,
+        pose_b,
+        options,
+        seed(HausdorffDirection::AToB),
+    )?;
     let forward = HausdorffResult {
         distance: ab.distance,
         upper_bound: ab.upper_bound,
@@ -143,12 +175,24 @@ pub fn hausdorff(
         point_b: ab.to_point,
         tri_a: ab.from_triangle,
         tri_b: ab.to_triangle,
+        warm_start: HausdorffWarmStart {
+            direction: HausdorffDirection::AToB,
+            point: ab.from_model_point,
+            triangle: ab.from_triangle,
+        },
         work: ab.work,
     };
     if !options.symmetric {
         return Ok(forward);
     }
-    let ba = one_sided(b, pose_b, a, pose_a, options)?;
+    let ba = one_sided(
+        b,
+        pose_b,
+        a,
+        pose_a,
+        options,
+        seed(HausdorffDirection::BToA),
+    )?;
     let mut work = ab.work;
     work += ba.work;
     let upper_bound = ab.upper_bound.max(ba.upper_bound);
@@ -161,6 +205,11 @@ pub fn hausdorff(
             point_b: ba.from_point,
             tri_a: ba.to_triangle,
             tri_b: ba.from_triangle,
+            warm_start: HausdorffWarmStart {
+                direction: HausdorffDirection::BToA,
+                point: ba.from_model_point,
+                triangle: ba.from_triangle,
+            },
             work,
         }
     } else {
@@ -180,19 +229,25 @@ struct OneSided {
     to_point: [f64; 3],
     from_triangle: u32,
     to_triangle: u32,
+    /// The witness in `from`'s model frame.
+    from_model_point: [f64; 3],
     work: Work,
 }
 
+/// h(from, to), its search started from `seed` (a point of `from` in its model frame, and
+/// its triangle's input id) when given.
 fn one_sided(
     from: &ObbtFile,
     pose_from: &Pose,
     to: &ObbtFile,
     pose_to: &Pose,
     options: &HausdorffOptions,
+    seed: Option<([f64; 3], u32)>,
 ) -> Result<OneSided, QueryError> {
     /// `from`'s vertices, faces (with their input ids) and nodes, in `to`'s model frame.
     struct Flatten {
         from_to_to: Pose,
+        seed: Option<([f64; 3], u32)>,
     }
     impl TreeVisitor for Flatten {
         type Output = Result<FromModel, QueryError>;
@@ -240,11 +295,15 @@ fn one_sided(
                 faces,
                 ids,
                 nodes,
+                seed: self
+                    .seed
+                    .map(|(p, id)| (self.from_to_to.apply(&p.into()), id)),
             })
         }
     }
     let from = from.visit(Flatten {
         from_to_to: Pose::relative(pose_to, pose_from),
+        seed,
     })??;
     /// The bounds, run on `to`'s typed tree.
     struct Bounds<'q> {
@@ -261,10 +320,14 @@ fn one_sided(
         from: &from,
         options,
     })??;
+    let from_point = pose_to.apply(&local.from_point);
     Ok(OneSided {
         distance: local.distance,
         upper_bound: local.upper_bound,
-        from_point: pose_to.apply(&local.from_point).into(),
+        from_model_point: Pose::relative(pose_from, &Pose::identity())
+            .apply(&from_point)
+            .into(),
+        from_point: from_point.into(),
         to_point: pose_to.apply(&local.to_point).into(),
         from_triangle: local.from_triangle,
         to_triangle: local.to_triangle,
@@ -540,6 +603,8 @@ struct FromModel {
     faces: Vec<[usize; 3]>,
     /// The faces' input ids.
     ids: Vec<u32>,
+    /// A point of `from` to measure first (an earlier witness) with its triangle's id.
+    seed: Option<(Vector3<f64>, u32)>,
     /// `from`'s tree, the root first.
     nodes: Vec<Ball>,
 }
@@ -803,6 +868,22 @@ fn bound<B: BoundingVolume>(
     let sample: Vec<usize> = in_leaf_order.step_by(SAMPLE_STRIDE).copied().collect();
     measure(tree, vertices, &sample, &mut nearest, &mut work)?;
     let mut witness = farthest(&nearest, vertices, &owner).ok_or(no_triangles.clone())?;
+    if let Some((point, triangle)) = from.seed {
+        let n = near(
+            tree,
+            &point,
+            Some(witness.near.face),
+            &mut BinaryHeap::new(),
+            &mut work,
+        )?;
+        if n.distance > witness.near.distance {
+            witness = Witness {
+                point,
+                near: n,
+                triangle,
+            };
+        }
+    }
     let (live, culled) = cull(
         tree,
         from,
@@ -830,7 +911,10 @@ fn bound<B: BoundingVolume>(
         }
     }
     measure(tree, vertices, &rest, &mut nearest, &mut work)?;
-    witness = farthest(&nearest, vertices, &owner).ok_or(no_triangles)?;
+    let vertex = farthest(&nearest, vertices, &owner).ok_or(no_triangles)?;
+    if vertex.near.distance > witness.near.distance {
+        witness = vertex;
+    }
     // Every kept triangle's bound; those that might raise the lower bound are refined.
     let first = enough(witness.near.distance);
     let bounded: Vec<(Piece, Option<Measured>, Work)> = live

@@ -49,7 +49,9 @@ pub use distance::{
     DistanceOptions, DistanceResult, ToleranceOptions, ToleranceResult, WarmStart, Witness,
 };
 pub use engine::QueryContext;
-pub use hausdorff::{hausdorff, HausdorffDirection, HausdorffOptions, HausdorffResult};
+pub use hausdorff::{
+    hausdorff, HausdorffDirection, HausdorffOptions, HausdorffResult, HausdorffWarmStart,
+};
 pub use pair_query::PairQuery;
 pub use ray::{all_ray_hits, cast_rays, Ray, RayHit, RayHits, RayMode, RayOptions, RayResult};
 pub use span::{SpanOptions, SpanResult};

@@ -252,8 +252,8 @@ fn meshes_match_brute_force_for_every_tree_type() {
             for (rel_err, symmetric) in [(0.0, false), (1e-3, false), (0.0, both)] {
                 let opts = HausdorffOptions {
                     rel_err,
-                    abs_err: 0.0,
                     symmetric,
+                    ..HausdorffOptions::default()
                 };
                 let h = hausdorff(&fa, &pa, &fb, &pb, &opts).expect("answers");
                 let what = format!("{name} {options:?} rel_err {rel_err} symmetric {symmetric}");
@@ -284,7 +284,7 @@ fn bad_options_are_refused() {
         let options = HausdorffOptions {
             rel_err,
             abs_err,
-            symmetric: false,
+            ..HausdorffOptions::default()
         };
         let error = hausdorff(&a, &id, &a, &id, &options).expect_err("refused");
         assert!(
@@ -468,4 +468,65 @@ fn a_ridge_between_two_faces_is_bounded_quadratically() {
         exact.work
     );
     assert_eq!(exact.work.nodes_visited, 6_486_474, "{:?}", exact.work);
+}
+
+/// A warm start from the answer at a nearby pose gives the same answer (to rounding) with
+/// less work, in both directions of a symmetric query; a warm start of the other direction
+/// only is ignored for the one it does not name.
+#[test]
+fn a_warm_start_keeps_the_answer_and_saves_work() {
+    let cow = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
+    let sphere = build(
+        &common::uv_sphere(0.2, 6, 8),
+        &BuildOptions::default(),
+        None,
+    )
+    .expect("builds");
+    let id = Pose::identity();
+    for (name, b, symmetric) in [
+        ("cow/turned cow", &cow, true),
+        ("cow/far sphere", &sphere, false),
+    ] {
+        let at = |x: f64| {
+            let turn = nalgebra::Rotation3::from_euler_angles(0.1 * x, 0.02, -0.03 * x);
+            Pose::new(turn.into_inner(), nalgebra::Vector3::new(0.3 + x, 0.1, 0.0))
+                .expect("a rotation")
+        };
+        let options = HausdorffOptions {
+            symmetric,
+            ..HausdorffOptions::default()
+        };
+        let first = hausdorff(&cow, &id, b, &at(0.0), &options).expect("answers");
+        let cold = hausdorff(&cow, &id, b, &at(0.01), &options).expect("answers");
+        let warm_options = HausdorffOptions {
+            warm_start: Some(first.warm_start),
+            ..options
+        };
+        let warm = hausdorff(&cow, &id, b, &at(0.01), &warm_options).expect("answers");
+        assert!(
+            (warm.distance - cold.distance).abs() <= 1e-12 * cold.distance,
+            "{name}: {warm:?} vs {cold:?}"
+        );
+        assert!(warm.distance <= cold.upper_bound && cold.distance <= warm.upper_bound);
+        assert!(
+            warm.work.bv_tests() < cold.work.bv_tests(),
+            "{name}: {:?} vs {:?}",
+            warm.work,
+            cold.work
+        );
+        // Its witness, back in the world, is where the answer was reached.
+        let on = |w: &HausdorffResult, pose: &Pose| {
+            let p = pose.apply(&nalgebra::Vector3::from(w.warm_start.point));
+            let q = match w.direction {
+                HausdorffDirection::AToB => w.point_a,
+                HausdorffDirection::BToA => w.point_b,
+            };
+            (p - nalgebra::Vector3::from(q)).norm()
+        };
+        let pose_of_witness = match cold.direction {
+            HausdorffDirection::AToB => id,
+            HausdorffDirection::BToA => at(0.01),
+        };
+        assert!(on(&cold, &pose_of_witness) < 1e-12, "{name}");
+    }
 }

@@ -66,6 +66,7 @@ pub unsafe extern "C" fn obbtree_hausdorff(
             rel_err,
             abs_err,
             symmetric,
+            warm_start: None,
         };
         let h = hausdorff(&a.file, &pa, &b.file, &pb, &options)?;
         out.write(ObbtreeHausdorffResult {

@@ -806,6 +806,7 @@ pub fn hausdorff(
         rel_err,
         abs_err,
         symmetric,
+        warm_start: None,
     };
     let (fa, fb) = (a.file()?, b.file()?);
     let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
