@@ -328,11 +328,7 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
                             }
                         }
                     })?;
-                let error = if d > 0.0 {
-                    (found - d).abs() / d
-                } else {
-                    found.abs()
-                };
+                let error = relative_error(found, d);
                 add(&mut trade, seconds, error, tests);
             }
             finish(&mut trade, scene.apart.len());
@@ -375,11 +371,7 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
                     let r = hausdorff(&a, pa, &b, pb, &options)?;
                     Ok::<_, QueryError>((r.distance, r.work.bv_tests()))
                 })?;
-                let error = if h > 0.0 {
-                    (found - h).abs() / h
-                } else {
-                    found.abs()
-                };
+                let error = relative_error(found, h);
                 add(&mut trade, seconds, error, tests);
             }
             finish(&mut trade, scene.crossing.len());
@@ -387,6 +379,15 @@ fn measure_workload(scene: &Workload, repeat: u32) -> Result<Vec<Trade>, Experim
         }
     }
     Ok(out)
+}
+
+/// `found`'s error against the exact answer `exact`: relative, or absolute at 0.
+fn relative_error(found: f64, exact: f64) -> f64 {
+    if exact > 0.0 {
+        (found - exact).abs() / exact
+    } else {
+        found.abs()
+    }
 }
 
 fn add(trade: &mut Trade, seconds: f64, error: f64, bv_tests: u64) {

@@ -397,22 +397,28 @@ struct Piece {
     triangle: u32,
 }
 
-impl PartialEq for Piece {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
+/// Orders a heap entry by its `upper` bound alone (largest first in a `BinaryHeap`).
+macro_rules! by_upper {
+    ($t:ty) => {
+        impl PartialEq for $t {
+            fn eq(&self, other: &Self) -> bool {
+                self.cmp(other) == Ordering::Equal
+            }
+        }
+        impl Eq for $t {}
+        impl PartialOrd for $t {
+            fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+                Some(self.cmp(other))
+            }
+        }
+        impl Ord for $t {
+            fn cmp(&self, other: &Self) -> Ordering {
+                self.upper.total_cmp(&other.upper)
+            }
+        }
+    };
 }
-impl Eq for Piece {}
-impl PartialOrd for Piece {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Piece {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.upper.total_cmp(&other.upper)
-    }
-}
+by_upper!(Piece);
 
 /// The convexity bound of a piece for one candidate triangle `face` of B: the largest
 /// distance from a corner to it (over the piece, the distance to one triangle is largest
@@ -609,6 +615,18 @@ struct FromModel {
     nodes: Vec<Ball>,
 }
 
+impl FromModel {
+    /// Node `index` of `from`'s tree.
+    fn node(&self, index: u32) -> Result<&Ball, QueryError> {
+        self.nodes
+            .get(index as usize)
+            .ok_or(QueryError::CorruptTree {
+                which: Side::A,
+                what: "a child past the node array",
+            })
+    }
+}
+
 /// A node of `from`'s tree: a ball holding its part of the surface, and what it holds.
 struct Ball {
     centre: Vector3<f64>,
@@ -661,22 +679,7 @@ struct Open {
     known: Option<(Vector3<f64>, Near)>,
 }
 
-impl PartialEq for Open {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Open {}
-impl PartialOrd for Open {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Open {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.upper.total_cmp(&other.upper)
-    }
-}
+by_upper!(Open);
 
 /// What [`cull`] reads and raises: the vertices measured and the farthest of them.
 struct Measures<'m> {
@@ -728,13 +731,7 @@ fn cull<B: BoundingVolume>(
             culled = culled.max(upper);
             break;
         }
-        let ball = from
-            .nodes
-            .get(index as usize)
-            .ok_or(QueryError::CorruptTree {
-                which: Side::A,
-                what: "a child past the node array",
-            })?;
+        let ball = from.node(index)?;
         work.nodes_visited += 1;
         let mut here = known;
         let mut upper = upper;
@@ -778,13 +775,7 @@ fn cull<B: BoundingVolume>(
             // (Children come after their parent: the pass ends on any file.)
             NodeKind::Children(children) => {
                 for child in children.clone() {
-                    let ball = from
-                        .nodes
-                        .get(child as usize)
-                        .ok_or(QueryError::CorruptTree {
-                            which: Side::A,
-                            what: "a child past the node array",
-                        })?;
+                    let ball = from.node(child)?;
                     let upper = here.map_or(f64::INFINITY, |(c, n)| {
                         n.distance + (ball.centre - c).norm() + ball.radius
                     });

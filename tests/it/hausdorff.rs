@@ -338,6 +338,12 @@ fn the_cli_answers_as_the_library() {
     assert_bad_input(&o, "rel_err must be finite and at least 0, got -0.5");
 }
 
+/// The bundled cow and a sphere of radius 0.2 (80 triangles), default trees.
+fn cow_and_small_sphere() -> (ObbtFile, ObbtFile) {
+    let tree = |mesh: &TriMesh| build(mesh, &BuildOptions::default(), None).expect("builds");
+    (tree(&common::cow()), tree(&common::uv_sphere(0.2, 6, 8)))
+}
+
 /// The work of fixed Hausdorff queries on the cow, pinned as `work_pins.rs` pins the pair
 /// queries': `[D, I, triangle tests, nodes visited]`. The answers are checked above; this
 /// notices a lost cull of A's nodes, a looser bound or a changed refinement, which leave
@@ -345,13 +351,7 @@ fn the_cli_answers_as_the_library() {
 /// one) and says before and after in its commit message.
 #[test]
 fn work_is_pinned() {
-    let cow = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
-    let sphere = build(
-        &common::uv_sphere(0.2, 6, 8),
-        &BuildOptions::default(),
-        None,
-    )
-    .expect("builds");
+    let (cow, sphere) = cow_and_small_sphere();
     let id = Pose::identity();
     let cases: [(&str, &ObbtFile, Pose, &ObbtFile, f64); 4] = [
         (
@@ -475,13 +475,7 @@ fn a_ridge_between_two_faces_is_bounded_quadratically() {
 /// only is ignored for the one it does not name.
 #[test]
 fn a_warm_start_keeps_the_answer_and_saves_work() {
-    let cow = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
-    let sphere = build(
-        &common::uv_sphere(0.2, 6, 8),
-        &BuildOptions::default(),
-        None,
-    )
-    .expect("builds");
+    let (cow, sphere) = cow_and_small_sphere();
     let id = Pose::identity();
     for (name, b, symmetric) in [
         ("cow/turned cow", &cow, true),
