@@ -97,16 +97,8 @@ const ILL_CONDITIONED: f64 = (1u64 << 20) as f64;
 fn nearest_of_edges_and_face(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
     let [a, b, c] = t;
     let mut best = (*a, Feature::Vertex(0), f64::INFINITY);
-    let n = (b - a).cross(&(c - a));
-    let n2 = n.norm_squared();
-    if n2 > 0.0 && n2.is_finite() {
-        let q = p - n * (n.dot(&(p - a)) / n2);
-        let inside = [(a, b), (b, c), (c, a)]
-            .iter()
-            .all(|&(s, e)| (e - s).cross(&(q - s)).dot(&n) >= 0.0);
-        if inside {
-            best = (q, Feature::Face, (p - q).norm_squared());
-        }
+    if let Some(q) = face_projection(p, t) {
+        best = (q, Feature::Face, (p - q).norm_squared());
     }
     for (k, (s, e)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
         // `k` is 0, 1 or 2.
@@ -117,6 +109,41 @@ fn nearest_of_edges_and_face(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, F
         }
     }
     (best.0, best.1)
+}
+
+/// The projection of `p` on the plane of `t` if it falls inside `t`, computed from the
+/// longest edge and the apex's height above it: on a sliver, the normal of a cross product
+/// of two nearly parallel edges points anywhere, this frame does not. A triangle whose
+/// height is lost to rounding has no inside (its edges answer for it).
+fn face_projection(p: &Vector3<f64>, t: &Triangle) -> Option<Vector3<f64>> {
+    let [a, b, c] = t;
+    let (s, e, r) = [(a, b, c), (b, c, a), (c, a, b)]
+        .into_iter()
+        .max_by(|x, y| {
+            (x.1 - x.0)
+                .norm_squared()
+                .total_cmp(&(y.1 - y.0).norm_squared())
+        })?;
+    let edge = e - s;
+    let l2 = edge.norm_squared();
+    if !(l2 > 0.0 && l2.is_finite()) {
+        return None;
+    }
+    // The apex's foot on the longest edge's line, and the unit direction up to it.
+    let along_r = (r - s).dot(&edge) / l2;
+    let up = r - (s + edge * along_r);
+    let height = up.norm();
+    if !(height > 0.0 && height.is_finite()) {
+        return None;
+    }
+    let up = up / height;
+    let along = (p - s).dot(&edge) / l2;
+    let across = (p - s).dot(&up);
+    // Inside: between the edge and the apex, and between the two other edges at that height.
+    let mu = across / height;
+    let inside =
+        (0.0..=1.0).contains(&mu) && along >= along_r * mu && along <= along_r * mu + (1.0 - mu);
+    inside.then(|| s + edge * along + up * across)
 }
 
 /// The point of segment `s → e` (edge `k` of its triangle) closest to `p`.
