@@ -199,7 +199,8 @@ impl ObbtFile {
     /// (O(1) in the file size).
     ///
     /// This is the one place obbtree maps files. The map is read-only and private to this
-    /// value; every later read goes through checked slices of it.
+    /// value; every later read goes through checked slices of it. See [`ObbtFile::read`]
+    /// for files that may be rewritten in place while open.
     ///
     /// # Errors
     ///
@@ -255,6 +256,53 @@ impl ObbtFile {
         ObbtFile::from_backing(backing).map_err(|source| OpenError::Format {
             path: path.to_path_buf(),
             source,
+        })
+    }
+
+    /// Reads `path` into memory and checks its header and directory: what
+    /// [`ObbtFile::open`] does, on a private copy instead of a map.
+    ///
+    /// Which to use: `open` costs O(1) whatever the file's size and shares the pages with
+    /// every other process that maps the file; it needs the file left alone while it is
+    /// open. Replacing it by rename (as `obbtree build` writes) is safe, and the open value
+    /// keeps answering from the old file; but a file truncated or rewritten in place while
+    /// mapped makes the next read of a lost page raise SIGBUS, which kills the process.
+    /// `read` costs a copy of the file and owns it: use it for files your program does not
+    /// control (downloads, shared folders, files other programs rewrite in place).
+    ///
+    /// # Errors
+    ///
+    /// As [`ObbtFile::open`]: [`OpenError::Io`] if the file cannot be read or is not a
+    /// regular file, [`OpenError::Format`] for the header and directory checks.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use obbtree::format::ObbtFile;
+    ///
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt");
+    /// let (mapped, copied) = (ObbtFile::open(path)?, ObbtFile::read(path)?);
+    /// assert_eq!(mapped.info(), copied.info());
+    /// # Ok::<(), obbtree::format::OpenError>(())
+    /// ```
+    pub fn read(path: impl AsRef<Path>) -> Result<ObbtFile, OpenError> {
+        let path = path.as_ref();
+        let io = |source| OpenError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        if std::fs::metadata(path).map_err(io)?.is_dir() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is a directory, not a .obbt file",
+            )));
+        }
+        let bytes = std::fs::read(path).map_err(io)?;
+        ObbtFile::from_aligned(AlignedBytes::copy_from(&bytes)).map_err(|source| {
+            OpenError::Format {
+                path: path.to_path_buf(),
+                source,
+            }
         })
     }
 

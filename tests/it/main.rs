@@ -28,6 +28,7 @@ mod hausdorff;
 mod hostile_cli;
 mod hostile_files;
 mod layouts;
+mod mapped_files;
 mod mesh_loaders;
 mod poses;
 mod queries;
