@@ -5,6 +5,8 @@
 // Test code outside `#[test]` functions (helpers): a failure is a failed test.
 #![allow(clippy::expect_used)]
 
+use crate::common::cli::{scratch, ScratchDir};
+
 use obbtree::format::{ObbtFile, OpenError};
 use obbtree::query::{PairQuery, Pose, SpanOptions};
 use std::path::{Path, PathBuf};
@@ -15,12 +17,12 @@ fn asset(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// A fresh directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("obbtree-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).expect("a scratch directory");
-    dir
+/// A scratch directory holding a copy of the bundled cow's tree, and the copy's path.
+fn cow_copy(name: &str) -> (ScratchDir, PathBuf) {
+    let dir = scratch(name);
+    let path = dir.join("model.obbt");
+    std::fs::copy(asset("cow.obbt"), &path).expect("copies");
+    (dir, path)
 }
 
 fn span(file: &ObbtFile) -> f64 {
@@ -34,9 +36,7 @@ fn span(file: &ObbtFile) -> f64 {
 
 #[test]
 fn a_file_replaced_by_rename_keeps_answering_from_the_old_one() {
-    let dir = scratch("rename");
-    let path = dir.join("model.obbt");
-    std::fs::copy(asset("cow.obbt"), &path).expect("copies");
+    let (dir, path) = cow_copy("mapped-rename");
     let cow = ObbtFile::open(&path).expect("opens");
     let expected = span(&cow);
     let table = ObbtFile::open(asset("table.obbt")).expect("opens");
@@ -58,14 +58,11 @@ fn a_file_replaced_by_rename_keeps_answering_from_the_old_one() {
     cow.verify().expect("the old contents are intact");
     let reopened = ObbtFile::open(&path).expect("opens");
     assert_eq!(reopened.info(), table.info());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn a_file_read_into_memory_survives_truncation_in_place() {
-    let dir = scratch("truncate");
-    let path = dir.join("model.obbt");
-    std::fs::copy(asset("cow.obbt"), &path).expect("copies");
+    let (dir, path) = cow_copy("mapped-truncate");
     let copied = ObbtFile::read(&path).expect("reads");
     assert_eq!(copied.info(), ObbtFile::open(&path).expect("opens").info());
     let expected = span(&copied);
@@ -85,5 +82,4 @@ fn a_file_read_into_memory_survives_truncation_in_place() {
         assert!(error.to_string().contains("model.obbt"), "{error}");
     }
     assert!(matches!(ObbtFile::read(&dir), Err(OpenError::Io { .. })));
-    std::fs::remove_dir_all(&dir).ok();
 }
