@@ -15,6 +15,7 @@ mod concurrency;
 mod contact_geometry;
 mod contact_work;
 mod corruption;
+mod dev_config;
 mod distance_work;
 mod doc_links;
 mod encoding;

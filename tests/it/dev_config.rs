@@ -1,0 +1,72 @@
+//! The development configuration files are what the development docs say they are.
+//!
+//! `.cargo/mutants.toml` is read only by `cargo mutants`, which no other test runs: once it
+//! was committed garbled (a megabyte of its own text repeated) and nothing noticed. Here it
+//! must parse, each examined glob must name files that exist, and each test filter must be
+//! `tests::` (the library's unit tests) or a module of this binary.
+// Test code: a failure is a failed test.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+
+use std::collections::BTreeSet;
+use std::fs;
+use std::path::Path;
+
+#[derive(serde::Deserialize)]
+struct MutantsConfig {
+    examine_globs: Vec<String>,
+    profile: String,
+    additional_cargo_test_args: Vec<String>,
+    exclude_re: Vec<String>,
+}
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Whether `glob` (a path, or a directory followed by `*.rs` or `**/*.rs`) names at least
+/// one file.
+fn glob_names_files(glob: &str) -> bool {
+    match glob.split_once('*') {
+        None => root().join(glob).is_file(),
+        Some((dir, _)) => fs::read_dir(root().join(dir)).is_ok_and(|entries| {
+            entries
+                .flatten()
+                .any(|e| e.path().extension().is_some_and(|x| x == "rs"))
+        }),
+    }
+}
+
+#[test]
+fn mutants_config_parses_and_names_what_exists() {
+    let text = fs::read_to_string(root().join(".cargo/mutants.toml")).unwrap();
+    let config: MutantsConfig = toml::from_str(&text).unwrap();
+    assert!(!config.examine_globs.is_empty());
+    for glob in &config.examine_globs {
+        assert!(glob_names_files(glob), "examine_globs names no file: {glob}");
+    }
+    let manifest = fs::read_to_string(root().join("Cargo.toml")).unwrap();
+    assert!(
+        manifest.contains(&format!("[profile.{}]", config.profile)),
+        "no [profile.{}] in Cargo.toml",
+        config.profile
+    );
+
+    let main = fs::read_to_string(root().join("tests/it/main.rs")).unwrap();
+    let modules: BTreeSet<&str> = main
+        .lines()
+        .filter_map(|l| l.strip_prefix("mod ")?.strip_suffix(';'))
+        .collect();
+    let args = &config.additional_cargo_test_args;
+    let dash = args.iter().position(|a| a == "--").unwrap();
+    assert_eq!(&args[..dash], ["--lib", "--test", "it"]);
+    for filter in &args[dash + 1..] {
+        let module = filter.strip_suffix("::").unwrap();
+        assert!(
+            module == "tests" || modules.contains(module),
+            "test filter {filter} is not a module of tests/it"
+        );
+    }
+    for re in &config.exclude_re {
+        assert!(re.starts_with("replace") || re.contains(": replace"), "{re}");
+    }
+}
