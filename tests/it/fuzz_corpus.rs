@@ -73,3 +73,23 @@ fn stl_loader_corpus() {
 fn differential_corpus() {
     replay("differential", differential::differential);
 }
+
+// The scene targets bring their own copy of the byte reader, as the differential one does.
+#[allow(clippy::duplicate_mod)]
+#[path = "../../fuzz/scene.rs"]
+mod scene;
+
+#[test]
+fn scene_differential_corpus() {
+    replay("scene_differential", scene::scene_differential);
+}
+
+#[test]
+fn scene_file_corpus() {
+    replay("scene_file", scene::scene_file);
+}
+
+#[test]
+fn frame_stream_corpus() {
+    replay("frame_stream", scene::frame_stream);
+}
