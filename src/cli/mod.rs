@@ -161,7 +161,15 @@ pub fn main() -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(failure) => {
-            eprintln!("obbtree: error: {failure}");
+            // One line whatever the error quotes: a path or a name may hold a newline.
+            let mut text = String::new();
+            for c in failure.to_string().chars() {
+                match c.is_control() {
+                    true => text.extend(c.escape_default()),
+                    false => text.push(c),
+                }
+            }
+            eprintln!("obbtree: error: {text}");
             ExitCode::from(1)
         }
     }

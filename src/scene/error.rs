@@ -1,12 +1,13 @@
 //! What can be wrong with a scene, its assets or its frames, located for people to fix.
 
 use std::error::Error;
-use std::fmt;
+use std::fmt::{self, Write as _};
 use std::sync::Arc;
 
 /// A refused scene file, asset or frame, or a query that failed in a scene.
 ///
-/// Displayed as one line, `ORIGIN:LINE: FIELD: MESSAGE` (parts omitted when unknown), for
+/// Displayed as one line, `ORIGIN:LINE: FIELD: MESSAGE` (parts omitted when unknown, control
+/// characters escaped), for
 /// example `cell.toml:14: rule 2, field a: no object or group named "robto"`.
 ///
 /// When another error is why (an I/O error, a TOML or JSON error, a pose, tree, mesh or
@@ -66,15 +67,31 @@ impl SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.origin)?;
+        write_escaped(f, &self.origin)?;
         if let Some(line) = self.line {
             write!(f, ":{line}")?;
         }
         if let Some(field) = &self.field {
-            write!(f, ": {field}")?;
+            f.write_str(": ")?;
+            write_escaped(f, field)?;
         }
-        write!(f, ": {}", self.message)
+        f.write_str(": ")?;
+        write_escaped(f, &self.message)
     }
+}
+
+/// Writes `text` with control characters escaped (a newline as `\n`): the parts come from
+/// what users wrote (a JSON key may hold a newline, a path anything), and must not break
+/// the one line.
+fn write_escaped(f: &mut fmt::Formatter<'_>, text: &str) -> fmt::Result {
+    for c in text.chars() {
+        if c.is_control() {
+            write!(f, "{}", c.escape_default())?;
+        } else {
+            f.write_char(c)?;
+        }
+    }
+    Ok(())
 }
 
 impl Error for SceneError {

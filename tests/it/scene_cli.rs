@@ -319,6 +319,15 @@ fn bad_frames_stop_at_their_line_after_printing_the_frames_before() {
             "frames.jsonl:3: not a frame: unknown field `pose`",
         ),
         ("", "frames.jsonl:3: empty line"),
+        // A name holding a newline (JSON's `\n`) is escaped, not printed as a line break.
+        (
+            "{\"poses\": {\"x\\ny\": [1,0,0, 0,1,0, 0,0,1, 0,0,0]}}",
+            "frames.jsonl:3: poses.x\\ny: no object named \"x\\ny\"",
+        ),
+        (
+            "{\"x\\ny\": {}}",
+            "frames.jsonl:3: not a frame: unknown field `x\\ny`",
+        ),
     ];
     for (bad, needle) in cases {
         let o = run(
