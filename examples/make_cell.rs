@@ -258,7 +258,7 @@ a = "gripper"
 b = "part"
 effect = "contacts"
 
-# A range sensor on the gripper: distance to the table every frame, "far" beyond 30 cm.
+# A range sensor on the gripper: its distance to the table while within 30 cm.
 [[rule]]
 a = "gripper"
 b = "table"

@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 ///   effect = "clearance"           # none | contact | contacts | clearance | distance | span
 ///   clearance = 0.05               # required for clearance
 ///   # rel_err = 0.01               # optional for distance
-///   # max_distance = 0.5           # optional for distance: beyond it, "far"
+///   # max_distance = 0.5           # optional for distance: beyond it, not listed
 ///
 /// Frames are JSON Lines, one frame per line: {"poses": {"link2": [12 numbers], ...}}.
 /// An object not named keeps its pose. Per frame the scheduler moves the world boxes of

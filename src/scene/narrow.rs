@@ -161,13 +161,13 @@ fn narrow(
             let closest = r
                 .closest
                 .filter(|w| max_distance.is_none_or(|m| w.distance < m));
-            let answer = closest.map_or(Answer::Beyond, |w| Answer::Distance {
+            let answer = closest.map(|w| Answer::Distance {
                 distance: w.distance,
                 tri_a: w.tri_a,
                 tri_b: w.tri_b,
             });
             let beyond = !naive && r.closest.is_none();
-            outcome(Some(answer), r.warm_start, r.work, beyond)
+            outcome(answer, r.warm_start, r.work, beyond)
         }
         (Effect::Span, _) => {
             let r = pair.span(pa, pb, &SpanOptions::default())?;

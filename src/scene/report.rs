@@ -33,9 +33,6 @@ pub enum Answer {
         /// Triangle of the second object.
         tri_b: u32,
     },
-    /// `distance` with `max_distance`: at least `max_distance` apart, so no distance was
-    /// computed. JSON writes it `"far": true`.
-    Beyond,
     /// `span`: the largest distance between the two.
     Span(f64),
 }
@@ -47,7 +44,7 @@ impl Answer {
             Answer::Contact => "contact",
             Answer::Contacts(_) => "contacts",
             Answer::Closer { .. } => "clearance",
-            Answer::Distance { .. } | Answer::Beyond => "distance",
+            Answer::Distance { .. } => "distance",
             Answer::Span(_) => "span",
         }
     }
@@ -95,7 +92,6 @@ impl Answer {
                 put("tri_a", json!(tri_a));
                 put("tri_b", json!(tri_b));
             }
-            Answer::Beyond => put("far", json!(true)),
             Answer::Span(span) => put("span", json!(span)),
         }
     }

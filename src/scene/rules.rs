@@ -19,8 +19,8 @@ pub enum Effect {
     Distance {
         /// Relative error allowed (0: exact).
         rel_err: f64,
-        /// At this distance or more the answer is [`Answer::Beyond`](super::Answer::Beyond)
-        /// and no exact value is computed.
+        /// At this distance or more the answer is empty (the pair is not listed) and no
+        /// exact value is computed.
         max_distance: Option<f64>,
     },
     /// The span: the largest distance between the two.

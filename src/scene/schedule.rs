@@ -50,13 +50,12 @@ pub(super) struct Schedule {
 
 impl Schedule {
     /// The schedule of `objects` at their current poses under the rules of `table`, before
-    /// any frame: limited distances start beyond `max_distance`, every other pair empty.
+    /// any frame: every pair empty.
     pub(super) fn new(objects: &[SceneObject], table: RuleTable) -> Schedule {
         let margins: Vec<f64> = (0..objects.len())
             .map(|i| 0.5 * table.reach_of(i))
             .collect();
-        let (mut always, mut limited, mut broad_pairs, mut with_effect) =
-            (Vec::new(), Vec::new(), 0u64, 0u64);
+        let (mut always, mut broad_pairs, mut with_effect) = (Vec::new(), 0u64, 0u64);
         let n = objects.len();
         for i in 0..n {
             for j in i + 1..n {
@@ -65,12 +64,7 @@ impl Schedule {
                 match effect.reach() {
                     Reach::Never => continue,
                     Reach::Always => always.push(pair),
-                    Reach::Within(_) => {
-                        broad_pairs += 1;
-                        if let Effect::Distance { .. } = effect {
-                            limited.push(pair);
-                        }
-                    }
+                    Reach::Within(_) => broad_pairs += 1,
                 }
                 with_effect += 1;
             }
@@ -85,21 +79,13 @@ impl Schedule {
             )
         });
         let mut states = FxHashMap::default();
-        for &pair in always.iter().chain(&limited) {
+        for &pair in &always {
             let effect = table.effect(pair.0 as usize, pair.1 as usize);
-            let answer = matches!(
-                effect,
-                Effect::Distance {
-                    max_distance: Some(_),
-                    ..
-                }
-            )
-            .then_some(Answer::Beyond);
             states.insert(
                 pair,
                 PairState {
                     effect,
-                    answer,
+                    answer: None,
                     answered: None,
                     warm_start: None,
                 },
@@ -110,7 +96,7 @@ impl Schedule {
             moved: vec![0; n],
             margins,
             broad,
-            listed: limited.iter().copied().collect(),
+            listed: BTreeSet::new(),
             always,
             broad_pairs,
             pairs_with_effect: with_effect,
@@ -182,9 +168,7 @@ impl Schedule {
             if let Some(state) = self.states.get_mut(&pair) {
                 state.answered = None;
                 let before = state.answer.take();
-                let empty =
-                    matches!(state.effect, Effect::Distance { .. }).then_some(Answer::Beyond);
-                set_answer(&mut self.listed, pair, state, empty, before, events);
+                set_answer(&mut self.listed, pair, state, None, before, events);
             }
         }
         let overlapping = self.broad.overlap_count() as u64;
