@@ -32,9 +32,8 @@ impl<R: Real> Aabb<R> {
         ((lo + hi) * 0.5, (hi - lo) * 0.5)
     }
 
-    /// The pair in box A's frame. Model axes are exactly orthonormal, so both setups are
-    /// the same and the slack is rounding only.
-    /// Centre, axes (the model's), half-widths and frame error (none), in f64.
+    /// Centre, axes (the model's), half-widths and frame error (none: model axes are
+    /// exactly orthonormal, so a pair's slack is rounding only), in f64.
     fn local_box(&self) -> (Vector3<f64>, Matrix3<f64>, Vector3<f64>, f64) {
         let (c, h) = self.center_half();
         (c, Matrix3::identity(), h, 0.0)

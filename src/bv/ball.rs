@@ -159,6 +159,48 @@ mod tests {
         assert!((reach(c, &line) - 2.0).abs() < 1e-9, "{c:?}");
     }
 
+    /// The degeneracy tests compare a measure with the size of the support, so whether a
+    /// support is degenerate does not depend on the units: nearly collinear triples and
+    /// nearly coplanar quadruples just below and above the threshold, at three scales.
+    #[test]
+    fn degeneracy_does_not_depend_on_scale() {
+        let v = |x: f64, y: f64, z: f64| Vector3::new(x, y, z);
+        for (eps, degenerate) in [(1e-13, true), (1e-9, false)] {
+            // Volume `eps` against a product of edge lengths about 0.7.
+            let quad = [
+                v(0.0, 0.0, 0.0),
+                v(1.0, 0.0, 0.0),
+                v(0.0, 1.0, 0.0),
+                v(0.5, 0.5, eps),
+            ];
+            // Squared area `eps²/4` against a product of squared lengths about 1.
+            let triple = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.5, eps, 0.0)];
+            for scale in [1e-3, 1.0, 1e3] {
+                let quad = quad.map(|p| p * scale);
+                let triple = triple.map(|p| p * scale);
+                assert_eq!(
+                    Ball::through(&quad).is_none(),
+                    degenerate,
+                    "{eps} at {scale}"
+                );
+                assert_eq!(
+                    Ball::through(&triple).is_none(),
+                    degenerate,
+                    "{eps} at {scale}"
+                );
+                // A ball found passes through its support.
+                for support in [&quad[..], &triple[..]] {
+                    if let Some(ball) = Ball::through(support) {
+                        for p in support {
+                            let r2 = (p - ball.center).norm_squared();
+                            assert!((r2 - ball.radius2).abs() <= 1e-4 * ball.radius2);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn random_clouds_get_a_ball_no_other_centre_improves() {
         let mut rng = crate::generate::Rng::new(5);

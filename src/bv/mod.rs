@@ -646,3 +646,40 @@ pub(crate) fn posed_box_aabb(
         max: (c + reach).into(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::Rng;
+
+    /// The broad phase trusts the world box to hold the whole posed box: every corner,
+    /// mapped by the pose in f64, lies inside it, under turned frames and far translations
+    /// whose rounding is many times the box's own ulps.
+    #[test]
+    fn posed_box_aabb_holds_every_posed_corner() {
+        let mut rng = Rng::new(3);
+        for k in 0..2000 {
+            let far = [0.0, 1.0, 1e6][k % 3];
+            let t = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * far;
+            let pose = Pose::new(rng.uniform_rotation(), t).unwrap_or_default();
+            let axes = rng.uniform_rotation().transpose();
+            let center = Vector3::new(rng.signed(), rng.signed(), rng.signed());
+            let half = Vector3::new(rng.unit(), rng.unit(), rng.unit());
+            let world = posed_box_aabb(&center, &axes, &half, 0.0, &pose);
+            for corner in 0..8 {
+                let sign = |i: usize| if corner >> i & 1 == 1 { 1.0 } else { -1.0 };
+                let local = center
+                    + (0..3)
+                        .map(|i| axes.row(i).transpose() * half[i] * sign(i))
+                        .sum::<Vector3<f64>>();
+                let p = pose.apply(&local);
+                for i in 0..3 {
+                    assert!(
+                        world.min[i] <= p[i] && p[i] <= world.max[i],
+                        "pose {k}, corner {corner}: {p:?} outside {world:?}"
+                    );
+                }
+            }
+        }
+    }
+}

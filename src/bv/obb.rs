@@ -414,3 +414,17 @@ impl<R: Real> BoundingVolume for Obb<R> {
 
     box_pair_methods!();
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Diameter, volume and surface area of a box of half-widths 1, 2, 3.
+    #[test]
+    fn box_measures_are_the_boxs() {
+        let (diameter, volume, area) = box_measures([1.0, 2.0, 3.0]);
+        assert!((diameter - 2.0 * 14f64.sqrt()).abs() < 1e-12);
+        assert_eq!(volume, 48.0);
+        assert_eq!(area, 88.0);
+    }
+}

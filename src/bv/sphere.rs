@@ -235,3 +235,64 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         4.0 * std::f64::consts::PI * self.radius.to_f64().powi(2)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::Rng;
+
+    /// The measures a descent rule and the statistics read, by their formulas.
+    #[test]
+    fn measures_are_the_spheres() {
+        let s = Sphere::<f64> {
+            center: [1.0, 2.0, 3.0],
+            radius: 2.0,
+        };
+        let pi = std::f64::consts::PI;
+        assert_eq!(s.diameter(), 4.0);
+        assert_eq!(s.thickness(), 4.0);
+        assert!((s.volume() - 32.0 / 3.0 * pi).abs() < 1e-12);
+        assert!((s.surface_area() - 16.0 * pi).abs() < 1e-12);
+    }
+
+    /// The world box holds the points at the radius along each axis from the posed centre,
+    /// near the origin and far from it.
+    #[test]
+    fn world_aabb_holds_the_posed_sphere() {
+        let mut rng = Rng::new(11);
+        for k in 0..2000 {
+            let far = [0.0, 1.0, 1e6][k % 3];
+            let t = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * far;
+            let pose = Pose::new(rng.uniform_rotation(), t).unwrap_or_default();
+            // Centres near the origin, or placed so that the posed centre is near it.
+            let local = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 1e6;
+            let center = if k % 2 == 0 {
+                local
+            } else {
+                pose.rotation().transpose() * (local - t)
+            };
+            let s = Sphere::<f64> {
+                center: center.into(),
+                radius: [1.0, 1e6][k / 2 % 2],
+            };
+            let world = s.world_aabb(&pose);
+            let c = pose.apply(&center);
+            for i in 0..3 {
+                let mut along = Vector3::zeros();
+                along[i] = s.radius;
+                // The points on the sphere along the axis, by mapping them from the model.
+                let back = pose.rotation().transpose() * along;
+                for p in [
+                    pose.apply(&(center + back)),
+                    pose.apply(&(center - back)),
+                    c,
+                ] {
+                    assert!(
+                        (0..3).all(|j| world.min[j] <= p[j] && p[j] <= world.max[j]),
+                        "case {k}: {p:?} outside {world:?}"
+                    );
+                }
+            }
+        }
+    }
+}
