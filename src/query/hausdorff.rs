@@ -4,17 +4,18 @@
 //! A's surface is cut into pieces, starting from its triangles. A piece's corners, each
 //! with its distance to B found by a closest-point descent of B's tree, give a lower bound
 //! on h (any surface point does). Its upper bound is convexity: the distance to one
-//! triangle `t` of B is a convex function, so over the piece it is largest at a corner, and
-//! `max over the piece of d(a, B) <= max over corners of d(corner, t)` for every `t`; the
-//! candidates are the triangles nearest the piece's corners. Pieces whose upper bound
-//! cannot raise the best lower bound (within the error asked) are dropped; the others are
-//! split in four at their edges' midpoints, largest upper bound first. Where one triangle
-//! of B is nearest a whole piece the bounds meet, so most pieces end at once; where the
-//! farthest point sits on a ridge between two triangles' regions, the convexity bound
-//! closes only linearly with the piece's size; there a second bound, the distance to the
-//! nearest of the points of B measured ([`point_bound`]), closes quadratically, and
-//! splitting stops at a floor where the peak of that bound is measured, the gap left
-//! reported.
+//! triangle `t` of B is a convex function, so at a point of the piece it is at most the
+//! corners' distances to `t` interpolated there, and `d(a, B)` at most the least of these
+//! planes over the candidate triangles (those nearest the corners and points measured
+//! inside); the envelope's peak over the piece is exact ([`interpolated_envelope`]). Pieces
+//! whose upper bound cannot raise the best lower bound (within the error asked) are
+//! dropped; the others are split in four at their edges' midpoints, largest upper bound
+//! first. Where one triangle of B is nearest a whole piece, or two faces of B meet at a
+//! ridge across it, the bounds meet once the peak is measured, so most pieces end at once;
+//! where B's nearest part curves (an edge or a corner) they close quadratically with the
+//! piece's size, helped by a second bound, the distance to the nearest of the points of B
+//! measured ([`point_bound`]). With an error asked, splitting goes on until it is met; exact
+//! answers stop at a floor where the peak of that bound is measured, the gap left reported.
 //!
 //! Before any piece, A's own tree culls: a sample of A's vertices gives a first lower
 //! bound, and a node whose ball (centre's distance to B plus radius) cannot exceed it is
@@ -39,10 +40,12 @@ use std::collections::BinaryHeap;
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HausdorffOptions {
     /// Relative error allowed (`>= 0`): the answer `h` and the true `h*` satisfy
-    /// `h <= h* <= h (1 + rel_err)` (or within `abs_err`, whichever is larger), unless the
-    /// splitting reaches its floor first (a ridge between two triangles' regions of B):
-    /// [`HausdorffResult::upper_bound`] is always what is proven. With both 0 (the
-    /// default) the answer is exact to f64 rounding, up to that floor.
+    /// `h <= h* <= h (1 + rel_err)` (or within `abs_err`, whichever is larger). With both
+    /// 0 (the default) the answer is exact to f64 rounding where the bounds close, and
+    /// splitting stops at a floor (2⁻¹⁶ of the measured model's diagonal) where they close
+    /// only slowly (B's nearest part curving, near-coincident surfaces); the same floor
+    /// stays for an allowance below 2⁻²⁴ of that diagonal (a relative error of an h about
+    /// 0). [`HausdorffResult::upper_bound`] is always what is proven.
     pub rel_err: f64,
     /// Absolute error allowed (`>= 0`, world units).
     pub abs_err: f64,
@@ -84,9 +87,9 @@ pub struct HausdorffResult {
     /// true distance is at least this.
     pub distance: f64,
     /// A proven bound the true distance does not exceed (rounding aside): at most the
-    /// error asked above `distance` (with errors 0, a few ulps of the models' coordinates:
-    /// exact to f64 rounding), or above it by the floor of the refinement where the
-    /// farthest point lies where two triangles of the other model are equally near.
+    /// error asked above `distance`, or with errors 0 a few ulps of the models'
+    /// coordinates (exact to f64 rounding) where the bounds close before the floor of the
+    /// refinement (see [`HausdorffOptions::rel_err`]), the gap left at the floor otherwise.
     pub upper_bound: f64,
     /// Which one-sided distance the witness realises.
     pub direction: HausdorffDirection,
@@ -107,11 +110,17 @@ pub struct HausdorffResult {
     pub work: Work,
 }
 
-/// Pieces are not split below this fraction of their model's bounding-box diagonal: there
-/// the bounds of a piece on a ridge between two triangles' regions are about its square
-/// apart, and a ridge across the model costs about a million descents. (At 2⁻²⁴ a fuzzed
-/// ridge of a few triangles took half a minute.)
+/// For exact answers, pieces are not split below this fraction of their model's
+/// bounding-box diagonal: there the bounds of a piece on a ridge where B's nearest part
+/// curves are about its square apart, and such a ridge across the model costs millions of
+/// descents. (At 2⁻²⁴ a fuzzed ridge of a few triangles took half a minute.)
 const FLOOR: f64 = 1.0 / (1u64 << 16) as f64;
+
+/// The least error, as a fraction of the measured model's bounding-box diagonal, that
+/// splitting goes below [`FLOOR`] to meet. Near-coincident surfaces triangulated
+/// differently have bounds that close only linearly, and h about 0: a relative error of
+/// that is an absolute one too fine to reach.
+const FINEST: f64 = 1.0 / (1u64 << 24) as f64;
 
 /// The Hausdorff distance from `a` posed by `pose_a` to `b` posed by `pose_b` (world
 /// frame): the largest distance from a point of A's surface to B's, with the point where
@@ -420,47 +429,144 @@ macro_rules! by_upper {
 }
 by_upper!(Piece);
 
-/// The convexity bound of a piece for one candidate triangle `face` of B: the largest
-/// distance from a corner to it (over the piece, the distance to one triangle is largest
-/// at a corner).
-fn candidate_bound<B: BoundingVolume>(
+/// The distances from a piece's corners to one candidate triangle `face` of B (a corner's
+/// own nearest triangle's distance is known).
+fn corner_distances<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     corners: &[Vector3<f64>; 3],
     near: &[Near; 3],
     face: u32,
     work: &mut Work,
-) -> Result<f64, QueryError> {
+) -> Result<Vector3<f64>, QueryError> {
     let t = triangle(tree, face, None, Side::B)?;
-    let mut worst: f64 = 0.0;
-    for (corner, n) in corners.iter().zip(near) {
-        // The nearest triangle's distance is known.
-        let d = if n.face == face {
+    let mut distances = Vector3::zeros();
+    for ((corner, n), d) in corners.iter().zip(near).zip(distances.iter_mut()) {
+        *d = if n.face == face {
             n.distance
         } else {
             work.tri_separated += 1;
             let (q, _) = closest_point_on_triangle(corner, &t);
             (corner - q).norm()
         };
-        worst = worst.max(d);
     }
-    Ok(worst)
+    Ok(distances)
 }
 
-/// The convexity bound of a piece over the candidate triangles nearest its corners: the
-/// least of their [`candidate_bound`]s.
-fn upper_bound<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
-    corners: &[Vector3<f64>; 3],
-    near: &[Near; 3],
-    work: &mut Work,
-) -> Result<f64, QueryError> {
-    let mut best = f64::INFINITY;
-    for (k, n) in near.iter().enumerate() {
-        if near.iter().take(k).all(|m| m.face != n.face) {
-            best = best.min(candidate_bound(tree, corners, near, n.face, work)?);
+/// The triangles of B tried as a piece's nearest (those nearest its corners, its centroid
+/// and the peak of its nearest-points bound), each with its distances from the corners.
+#[derive(Default)]
+struct Candidates {
+    faces: [u32; Candidates::MAX],
+    distances: [Vector3<f64>; Candidates::MAX],
+    len: usize,
+}
+
+impl Candidates {
+    /// The corners' and the probes'.
+    const MAX: usize = 3 + PROBES;
+
+    /// Tries `face` too (once; beyond [`Candidates::MAX`] the bound just stays looser).
+    fn add<B: BoundingVolume>(
+        &mut self,
+        tree: &TreeView<'_, B>,
+        (corners, near): (&[Vector3<f64>; 3], &[Near; 3]),
+        face: u32,
+        work: &mut Work,
+    ) -> Result<(), QueryError> {
+        if self.faces.iter().take(self.len).any(|&f| f == face) {
+            return Ok(());
+        }
+        let distances = corner_distances(tree, corners, near, face, work)?;
+        if let (Some(f), Some(d)) = (
+            self.faces.get_mut(self.len),
+            self.distances.get_mut(self.len),
+        ) {
+            *f = face;
+            *d = distances;
+            self.len += 1;
+        }
+        Ok(())
+    }
+
+    /// The convexity bound of the piece and the barycentric coordinates where it peaks:
+    /// see [`interpolated_envelope`].
+    fn bound(&self) -> (f64, Vector3<f64>) {
+        interpolated_envelope(self.distances.get(..self.len).unwrap_or_default())
+    }
+
+    /// The convexity bound where it may decide the piece, else a cheaper, looser one at
+    /// most `threshold` off: the least over candidates of their largest corner distance
+    /// (which the envelope never exceeds) when that is already within `threshold`.
+    fn bound_against(&self, threshold: f64) -> f64 {
+        let loose = self
+            .distances
+            .iter()
+            .take(self.len)
+            .map(|d| d.max())
+            .fold(f64::INFINITY, f64::min);
+        if loose <= threshold {
+            loose
+        } else {
+            self.bound().0
         }
     }
-    Ok(best)
+}
+
+/// The convexity bound of a piece from its corners' distances to some triangles `t` of B
+/// (`distances[t]`, one per corner). The distance to one triangle is convex, so at the
+/// point of barycentric coordinates `λ` it is at most `λ · distances[t]`, and the distance
+/// to B at most the least of these planes. That lower envelope is concave and piecewise
+/// linear, so its largest value over the piece is at a vertex of its pieces: a corner,
+/// where two planes cross on an edge, or where three meet inside, all of which are tried.
+/// Where the nearest triangle changes inside the piece between two faces of B (a ridge),
+/// the planes are the distances themselves and the bound is exact at any size; the
+/// largest over corners of one triangle's distances, the bound before, closed only linearly.
+fn interpolated_envelope(distances: &[Vector3<f64>]) -> (f64, Vector3<f64>) {
+    let at = |l: &Vector3<f64>| {
+        distances
+            .iter()
+            .map(|d| d.dot(l))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (x, y, z) = (Vector3::x(), Vector3::y(), Vector3::z());
+    let mut best = (at(&x), x);
+    let mut offer = |l: Vector3<f64>| {
+        let e = at(&l);
+        if e > best.0 {
+            best = (e, l);
+        }
+    };
+    offer(y);
+    offer(z);
+    let edges = [(x, y), (y, z), (z, x)];
+    for (s, ds) in distances.iter().enumerate() {
+        for (t, dt) in distances.iter().enumerate().skip(s + 1) {
+            let gap = ds - dt;
+            for (e, f) in &edges {
+                let (ge, gf) = (gap.dot(e), gap.dot(f));
+                if (ge > 0.0 && gf < 0.0) || (ge < 0.0 && gf > 0.0) {
+                    let u = ge / (ge - gf);
+                    offer(e * (1.0 - u) + f * u);
+                }
+            }
+            for du in distances.iter().skip(t + 1) {
+                // Where the three planes meet: `gap · λ = 0`, `other · λ = 0` with
+                // `λ.z = 1 - λ.x - λ.y`, two equations in `λ.x`, `λ.y` (Cramer's rule).
+                let other = ds - du;
+                let row = |g: &Vector3<f64>| (g.x - g.z, g.y - g.z, -g.z);
+                let ((a, b, c), (d, e, f)) = (row(&gap), row(&other));
+                let det = a * e - b * d;
+                if det != 0.0 {
+                    let (x, y) = ((c * e - b * f) / det, (a * f - c * d) / det);
+                    let l = Vector3::new(x, y, 1.0 - x - y);
+                    if l.iter().all(|&v| v >= 0.0) {
+                        offer(l);
+                    }
+                }
+            }
+        }
+    }
+    best
 }
 
 /// The nearest-points bound of a piece: no point `x` of it is farther from B than from the
@@ -543,10 +649,13 @@ fn point_bound(corners: &[Vector3<f64>; 3], points: &[Vector3<f64>]) -> (f64, Ve
 }
 
 /// A piece's bound, and the farthest of the points measured inside it with what is nearest
-/// it. When the corners' candidates alone leave the bound above `threshold`, its centroid
-/// is measured (the triangle nearest the middle often bounds a piece whose corners each see
-/// another: a corner of A shared by several triangles of B), and then, if still above, the
-/// peak of the nearest-points bound.
+/// it. While the bound is above `threshold`, points inside are measured ([`PROBES`]), each
+/// adding its nearest triangle to the candidates and its nearest point to the
+/// nearest-points bound: the centroid (the triangle nearest the middle often bounds a piece
+/// whose corners each see another: a corner of A shared by several triangles of B), where
+/// the convexity bound peaks (on a ridge between two faces of B, the ridge itself: the
+/// distance there is the bound, and measuring it closes the piece), and where the
+/// nearest-points bound peaks (near a ridge where B curves: an edge or a vertex nearest).
 fn bounded_piece<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     corners: [Vector3<f64>; 3],
@@ -555,33 +664,50 @@ fn bounded_piece<B: BoundingVolume>(
     threshold: f64,
     (heap, work): (&mut BinaryHeap<Waiting>, &mut Work),
 ) -> Result<(Piece, Option<Measured>), QueryError> {
-    let nearest = near.map(|n| n.point);
-    let mut upper =
-        upper_bound(tree, &corners, &near, work)?.min(point_bound(&corners, &nearest).0);
-    let mut middle = None;
+    let mut candidates = Candidates::default();
+    for n in &near {
+        candidates.add(tree, (&corners, &near), n.face, work)?;
+    }
+    // The nearest points of B measured: the corners', then those of the probes.
+    let mut points = [near[0].point; 3 + PROBES];
+    for (slot, n) in points.iter_mut().zip(&near) {
+        *slot = n.point;
+    }
+    let mut measured = 3;
+    let bound = |points: &[Vector3<f64>; 3 + PROBES], measured: usize| {
+        point_bound(&corners, points.get(..measured).unwrap_or_default())
+    };
+    let mut upper = candidates.bound_against(threshold);
     if upper > threshold {
-        let c = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let n = self::near(tree, &c, Some(near[0].face), heap, work)?;
-        // (A corner's triangle is bounded already.)
-        if near.iter().all(|m| m.face != n.face) {
-            upper = upper.min(candidate_bound(tree, &corners, &near, n.face, work)?);
+        upper = upper.min(bound(&points, measured).0);
+    }
+    let mut middle: Option<Measured> = None;
+    let mut seed = near[0].face;
+    for probe in 0..PROBES {
+        if upper <= threshold {
+            break;
         }
-        let [q0, q1, q2] = nearest;
-        let (bound, peak) = point_bound(&corners, &[q0, q1, q2, n.point]);
-        upper = upper.min(bound);
-        middle = Some((c, n));
+        let x = match probe {
+            0 => (corners[0] + corners[1] + corners[2]) / 3.0,
+            1 => {
+                let (_, l) = candidates.bound();
+                corners[0] * l.x + corners[1] * l.y + corners[2] * l.z
+            }
+            _ => bound(&points, measured).1,
+        };
+        let m = self::near(tree, &x, Some(seed), heap, work)?;
+        seed = m.face;
+        candidates.add(tree, (&corners, &near), m.face, work)?;
+        if let Some(slot) = points.get_mut(measured) {
+            *slot = m.point;
+            measured += 1;
+        }
+        upper = upper.min(candidates.bound_against(threshold));
         if upper > threshold {
-            // Where the nearest-points bound peaks, the distance most likely does: across a
-            // ridge between two triangles' regions of B, corners and middles fall short of
-            // it linearly with the piece's size, that point quadratically.
-            let m = self::near(tree, &peak, Some(n.face), heap, work)?;
-            if near.iter().all(|x| x.face != m.face) && m.face != n.face {
-                upper = upper.min(candidate_bound(tree, &corners, &near, m.face, work)?);
-            }
-            upper = upper.min(point_bound(&corners, &[q0, q1, q2, n.point, m.point]).0);
-            if m.distance > n.distance {
-                middle = Some((peak, m));
-            }
+            upper = upper.min(bound(&points, measured).0);
+        }
+        if middle.is_none_or(|(_, k)| m.distance > k.distance) {
+            middle = Some((x, m));
         }
     }
     let piece = Piece {
@@ -633,6 +759,10 @@ struct Ball {
     radius: f64,
     kind: NodeKind,
 }
+
+/// The points measured inside a piece whose corners leave its bound open: see
+/// [`bounded_piece`].
+const PROBES: usize = 2;
 
 /// One vertex in this many is measured before the nodes of `from` are culled, for a first
 /// lower bound; the rest only where their triangles survive.
@@ -831,7 +961,19 @@ fn bound<B: BoundingVolume>(
         ),
         |(lo, hi), p| (lo.inf(p), hi.sup(p)),
     );
-    let floor = FLOOR * (hi - lo).norm();
+    let diagonal = (hi - lo).norm();
+    // Pieces smaller than the error allowed are within it (a point of a piece is no farther
+    // from B than a corner is plus its distance to that corner), so with an error asked
+    // splitting goes on until the bounds meet it; below `FINEST` of the diagonal (only a
+    // relative error, and h about 0), and for exact answers, it stops at `FLOOR`.
+    let floor = |lower: f64| {
+        let allowed = (options.rel_err * lower).max(options.abs_err);
+        if allowed >= FINEST * diagonal {
+            allowed.min(FLOOR * diagonal)
+        } else {
+            FLOOR * diagonal
+        }
+    };
     // Distances between points of this magnitude are only known to a few ulps of it:
     // bounds that close to each other are exact to f64 rounding.
     let rounding = 8.0 * f64::EPSILON * lo.abs().sup(&hi.abs()).max();
@@ -968,7 +1110,7 @@ fn bound<B: BoundingVolume>(
         }
         let [p0, p1, p2] = piece.corners;
         let longest = (p1 - p0).norm().max((p2 - p1).norm()).max((p0 - p2).norm());
-        if longest <= floor {
+        if longest <= floor(witness.near.distance) {
             // Split no further; where the nearest-points bound peaks is where the distance
             // most likely does (across a ridge between two triangles' regions of B, the
             // corners and middles sampled so far fall short of it linearly).
@@ -1048,4 +1190,77 @@ fn bound<B: BoundingVolume>(
         to_triangle: witness.near.id,
         work,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The least of the planes at `l`, the function [`interpolated_envelope`] maximises.
+    fn least(distances: &[Vector3<f64>], l: &Vector3<f64>) -> f64 {
+        distances
+            .iter()
+            .map(|d| d.dot(l))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The envelope's peak is where it says, and no point of a fine barycentric grid is
+    /// above it nor, at the grid's spacing, much below: for one to five candidates with
+    /// pseudo-random corner distances.
+    #[test]
+    fn the_envelope_peak_is_the_largest_value_over_the_piece() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        const N: u32 = 60;
+        for case in 0..300 {
+            let count = 1 + case % 5;
+            let distances: Vec<Vector3<f64>> = (0..count)
+                .map(|_| Vector3::new(next(), next(), next()) * 4.0)
+                .collect();
+            let (peak, at) = interpolated_envelope(&distances);
+            assert!(at.iter().all(|&v| v >= 0.0) && (at.sum() - 1.0).abs() < 1e-12);
+            assert!((least(&distances, &at) - peak).abs() < 1e-12, "case {case}");
+            let mut sampled = f64::NEG_INFINITY;
+            for i in 0..=N {
+                for j in 0..=N - i {
+                    let l = Vector3::new(f64::from(i), f64::from(j), f64::from(N - i - j))
+                        / f64::from(N);
+                    sampled = sampled.max(least(&distances, &l));
+                }
+            }
+            assert!(
+                sampled <= peak + 1e-12,
+                "case {case}: {sampled} above {peak}"
+            );
+            // Each plane's slope is at most 4 per unit of λ; a grid point is within 1/N.
+            assert!(
+                peak <= sampled + 8.0 / f64::from(N),
+                "case {case}: {peak} vs {sampled}"
+            );
+        }
+    }
+
+    /// Two faces' distances crossing inside the piece: the peak is where they are equal,
+    /// below both planes' largest corner values (the bound before this one).
+    #[test]
+    fn two_crossing_planes_peak_on_their_crossing() {
+        let distances = [Vector3::new(0.0, 2.0, 1.0), Vector3::new(2.0, 0.0, 1.0)];
+        let (peak, at) = interpolated_envelope(&distances);
+        assert!((peak - 1.0).abs() < 1e-15, "{peak} at {at:?}");
+        assert!((at.x - at.y).abs() < 1e-15);
+        // Three planes equal at the centroid, lower at every corner.
+        let three = [
+            Vector3::new(0.0, 3.0, 3.0),
+            Vector3::new(3.0, 0.0, 3.0),
+            Vector3::new(3.0, 3.0, 0.0),
+        ];
+        let (peak, at) = interpolated_envelope(&three);
+        assert!((peak - 2.0).abs() < 1e-12, "{peak} at {at:?}");
+        assert!((at - Vector3::repeat(1.0 / 3.0)).norm() < 1e-12);
+    }
 }

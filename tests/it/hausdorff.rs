@@ -257,7 +257,9 @@ fn meshes_match_brute_force_for_every_tree_type() {
                 };
                 let h = hausdorff(&fa, &pa, &fb, &pb, &opts).expect("answers");
                 let what = format!("{name} {options:?} rel_err {rel_err} symmetric {symmetric}");
-                check(&h, &ta, &tb, samples, &opts, floor_gap, &what);
+                // An error asked is met whatever the floor (see the test below).
+                let gap = if rel_err > 0.0 { 0.0 } else { floor_gap };
+                check(&h, &ta, &tb, samples, &opts, gap, &what);
                 if symmetric {
                     let one = |x, px, y, py| {
                         hausdorff(x, px, y, py, &HausdorffOptions::default())
@@ -381,7 +383,7 @@ fn work_is_pinned() {
         ("cow/turned cow", [19159, 26058, 3859, 44738]),
         ("cow/turned cow rel_err 0.01", [15074, 20428, 3003, 34948]),
         ("cow/far sphere", [5660, 9901, 2310, 15697]),
-        ("sphere/cow", [15938, 19369, 2717, 34707]),
+        ("sphere/cow", [15856, 19314, 2726, 34556]),
     ];
     let measured: Vec<(&str, [u64; 4])> = cases
         .iter()
@@ -410,11 +412,13 @@ fn work_is_pinned() {
 /// A flat A above a V-shaped valley B: every point of A over the valley's floor line is
 /// equally far from both faces, and farther than any other, so h lies all along a ridge
 /// between the two faces' regions, across A's triangles. The exact answer is the closed
-/// form to 1e-9 with its bound as close; the work is pinned (the floor and the
-/// nearest-points bound decide it: at the old floor of 2^-24 a ridge of this kind took
-/// half a minute), and an error allowance costs a small share of it.
+/// form with its bound as close, and the work is pinned: the convexity bound interpolates
+/// each face's distance, which is linear there, so a piece across the ridge is bounded
+/// exactly and closes once the ridge is measured. (With the larger of the corners'
+/// distances to one face it closed only linearly: pieces split to the floor all along the
+/// ridge, 6,486,474 nodes.)
 #[test]
-fn a_ridge_between_two_faces_is_bounded_quadratically() {
+fn a_ridge_between_two_faces_is_closed_exactly() {
     let k = 0.5;
     let valley = TriMesh::new(
         vec![
@@ -446,28 +450,45 @@ fn a_ridge_between_two_faces_is_bounded_quadratically() {
     let id = Pose::identity();
     let closed_form = 1.0 / (1.0 + k * k).sqrt();
     let exact = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
-    assert!((exact.distance - closed_form).abs() <= 1e-9, "{exact:?}");
-    assert!(exact.upper_bound - exact.distance <= 1e-9, "{exact:?}");
+    assert!((exact.distance - closed_form).abs() <= 1e-15, "{exact:?}");
+    assert!(exact.upper_bound - exact.distance <= 1e-15, "{exact:?}");
     assert!(
-        exact.point_a[0].abs() <= 1e-4,
+        exact.point_a[0].abs() <= 1e-12,
         "the witness is off the ridge: {exact:?}"
     );
-    let loose = HausdorffOptions {
-        rel_err: 1e-6,
-        ..HausdorffOptions::default()
+    assert_eq!(exact.work.nodes_visited, 180, "{:?}", exact.work);
+}
+
+/// Where h is about 0 and only a relative error is asked, splitting still stops at the
+/// floor: a square against itself triangulated along the other diagonal, whose pieces
+/// across the diagonal are bounded only linearly (splitting them to meet 1% of h = 0 would
+/// not end). The answer comes at once with the gap the floor leaves. (An error asked of an
+/// h not about 0 is met beyond the floor: the fuzz regressions `hausdorff-gap-at-floor-*`,
+/// held to it by the differential target.)
+#[test]
+fn near_coincident_surfaces_keep_the_floor() {
+    let flipped = {
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let mesh = TriMesh::new(v, vec![[0, 1, 3], [1, 2, 3]]).expect("a square");
+        build(&mesh, &BuildOptions::default(), None).expect("builds")
     };
-    let approximate = hausdorff(&a, &id, &b, &id, &loose).expect("answers");
-    assert!(
-        approximate.upper_bound >= closed_form - 1e-12,
-        "{approximate:?}"
-    );
-    assert!(
-        approximate.work.nodes_visited * 20 < exact.work.nodes_visited,
-        "{:?} vs {:?}",
-        approximate.work,
-        exact.work
-    );
-    assert_eq!(exact.work.nodes_visited, 6_486_474, "{:?}", exact.work);
+    let id = Pose::identity();
+    let floor_gap = 2f64.sqrt() / f64::from(1u32 << 16);
+    for rel_err in [0.0, 0.01] {
+        let options = HausdorffOptions {
+            rel_err,
+            ..HausdorffOptions::default()
+        };
+        let h = hausdorff(&square(0.0, 0.0), &id, &flipped, &id, &options).expect("answers");
+        assert!(h.distance <= 1e-15, "{h:?}");
+        assert!(h.upper_bound <= floor_gap, "{h:?}");
+        assert!(h.work.nodes_visited < 4_000_000, "{h:?}");
+    }
 }
 
 /// A warm start from the answer at a nearby pose gives the same answer (to rounding) with
