@@ -53,6 +53,8 @@ struct Config {
     hull_max_points: u32,
     /// `BuildOptions::model_axes`.
     model_axes: bool,
+    /// `BuildOptions::split_by_volume`.
+    split_by_volume: bool,
     guard: f64,
     rel_err: f64,
 }
@@ -64,6 +66,7 @@ const BASELINE: Config = Config {
     hull_min_faces: DEFAULT_HULL_MIN_FACES,
     hull_max_points: DEFAULT_HULL_MAX_POINTS,
     model_axes: true,
+    split_by_volume: true,
     guard: SAT_GUARD,
     rel_err: 0.0,
 };
@@ -91,11 +94,13 @@ const CONFIGS: [Config; 8] = [
         ..BASELINE
     },
     Config {
-        // The dissertation's §3.4 as written: every node, every vertex, fitted frames only.
+        // The dissertation's §3.4 as written: every node, every vertex, fitted frames only,
+        // split along the greatest spread.
         name: "fit-hull-everywhere",
         hull_min_faces: 1,
         hull_max_points: u32::MAX,
         model_axes: false,
+        split_by_volume: false,
         ..BASELINE
     },
     Config {
@@ -118,6 +123,7 @@ impl Config {
             hull_min_faces: self.hull_min_faces,
             hull_max_points: self.hull_max_points,
             model_axes: self.model_axes,
+            split_by_volume: self.split_by_volume,
             ..BuildOptions::default()
         }
     }
@@ -129,6 +135,7 @@ impl Config {
             || self.hull_min_faces != BASELINE.hull_min_faces
             || self.hull_max_points != BASELINE.hull_max_points
             || self.model_axes != BASELINE.model_axes
+            || self.split_by_volume != BASELINE.split_by_volume
             || self.name == "baseline"
     }
 }

@@ -108,6 +108,7 @@ fn check_mesh(mesh: &TriMesh, data: &[u8]) {
         // Small enough that fuzzed meshes get sampled hulls too.
         hull_max_points: [4, DEFAULT_HULL_MAX_POINTS][(pick / 864) % 2],
         model_axes: (pick / 1728) % 2 == 0,
+        split_by_volume: (pick / 6912) % 2 == 0,
         // Minimal balls apply to sphere trees only.
         sphere_fit: if bv == BvKind::Sphere && (pick / 3456) % 2 == 1 {
             SphereFit::Minimal

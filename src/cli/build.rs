@@ -95,6 +95,12 @@ pub struct TreeArgs {
     /// smaller: parts modelled along their axes (CAD) get much tighter boxes [default: yes].
     #[arg(long, value_name = "yes|no", value_parser = parse_yes_no)]
     pub model_axes: Option<bool>,
+    /// Split each node along whichever of its box's axes halves it into the least total
+    /// volume, the axis of greatest spread unless another is clearly better: far fewer tests
+    /// on CAD parts of long, thin triangles; `no` always splits along the greatest spread,
+    /// as §3.4 does [default: yes].
+    #[arg(long, value_name = "yes|no", value_parser = parse_yes_no)]
+    pub split_by_volume: Option<bool>,
     /// With --bv sphere, where each sphere is centred: on its node's box centre, or on
     /// the centre of the smallest ball of its vertices (tighter, slower to build; the
     /// spheres the dissertation's comparisons used) [default: box-centre].
@@ -208,6 +214,7 @@ impl TreeArgs {
             hull_max_points: self.hull_max_points.unwrap_or(default.hull_max_points),
             leaf_size: self.leaf_size.unwrap_or(layout.default_leaf_size()),
             model_axes: self.model_axes.unwrap_or(default.model_axes),
+            split_by_volume: self.split_by_volume.unwrap_or(default.split_by_volume),
             sphere_fit: self.sphere_fit.map_or(default.sphere_fit, |f| match f {
                 SphereFitArg::BoxCentre => SphereFit::BoxCentre,
                 SphereFitArg::Minimal => SphereFit::Minimal,
@@ -224,6 +231,7 @@ impl TreeArgs {
             ("--hull-min-faces", self.hull_min_faces.is_some()),
             ("--hull-max-points", self.hull_max_points.is_some()),
             ("--model-axes", self.model_axes.is_some()),
+            ("--split-by-volume", self.split_by_volume.is_some()),
             ("--sphere-fit", self.sphere_fit.is_some()),
             ("--leaf-size", self.leaf_size.is_some()),
             ("--precision", self.precision.is_some()),

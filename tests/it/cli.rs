@@ -910,6 +910,15 @@ fn build_help_states_the_library_defaults() {
             "--model-axes",
             if defaults.model_axes { "yes" } else { "no" }.to_string(),
         ),
+        (
+            "--split-by-volume",
+            if defaults.split_by_volume {
+                "yes"
+            } else {
+                "no"
+            }
+            .to_string(),
+        ),
         ("--layout", defaults.layout.name().to_string()),
     ] {
         // The flag's own entry (`--flag <VALUE>`), not a mention in another's text.
@@ -989,11 +998,19 @@ fn hull_options_out_of_range_or_without_the_hull_fit_are_exit_1() {
 }
 
 #[test]
-fn model_axes_no_changes_the_tree_and_other_words_are_refused() {
-    let dir = scratch("model_axes");
+fn model_axes_and_split_by_volume_no_change_the_tree_and_other_words_are_refused() {
+    for flag in ["--model-axes", "--split-by-volume"] {
+        yes_no_flag_changes_the_tree(flag);
+    }
+}
+
+/// `flag no` builds another tree than the default, both verify, and a word other than
+/// yes or no is refused naming the flag, writing nothing.
+fn yes_no_flag_changes_the_tree(flag: &str) {
+    let dir = scratch(&flag.replace('-', ""));
     let (default, fitted) = (dir.join("default.obbt"), dir.join("fitted.obbt"));
     build(&default, &[]);
-    build(&fitted, &["--model-axes", "no"]);
+    build(&fitted, &[flag, "no"]);
     assert_ne!(
         std::fs::read(&default).unwrap(),
         std::fs::read(&fitted).unwrap()
@@ -1008,10 +1025,10 @@ fn model_axes_no_changes_the_tree_and_other_words_are_refused() {
         cow().as_str(),
         "-o",
         out.to_str().unwrap(),
-        "--model-axes",
+        flag,
         "maybe",
     ]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("--model-axes"), "{}", stderr(&o));
+    assert!(stderr(&o).contains(flag), "{}", stderr(&o));
     assert!(!out.exists());
 }

@@ -380,10 +380,10 @@ fn work_is_pinned() {
         ("sphere/cow", &sphere, id, &cow, 0.0),
     ];
     let pinned: [(&str, [u64; 4]); 4] = [
-        ("cow/turned cow", [19159, 26058, 3859, 44738]),
-        ("cow/turned cow rel_err 0.01", [15074, 20428, 3003, 34948]),
-        ("cow/far sphere", [5660, 9901, 2310, 15697]),
-        ("sphere/cow", [15856, 19314, 2726, 34556]),
+        ("cow/turned cow", [19204, 26044, 3815, 44790]),
+        ("cow/turned cow rel_err 0.01", [15526, 21054, 3089, 36055]),
+        ("cow/far sphere", [5399, 10330, 2658, 15869]),
+        ("sphere/cow", [15968, 19562, 2786, 34831]),
     ];
     let measured: Vec<(&str, [u64; 4])> = cases
         .iter()

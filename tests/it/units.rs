@@ -193,9 +193,9 @@ fn scale_and_center_place_the_model_and_are_recorded() {
 
 /// CRC-32 and length of the default cow build and of an AABB f64 leaf-size-4 build, as
 /// written before the placement existed (format 1.0), when the hull fit ran at every node
-/// over every vertex and never on the model's axes (`hull_min_faces` 1, `hull_max_points`
-/// unlimited, `model_axes` off). A file built without a placement must stay exactly what a 1.0
-/// writer wrote.
+/// over every vertex, never on the model's axes and split along the greatest spread only
+/// (`hull_min_faces` 1, `hull_max_points` unlimited, `model_axes` and `split_by_volume` off).
+/// A file built without a placement must stay exactly what a 1.0 writer wrote.
 const COW_1_0: [(u32, usize); 2] = [(0x7335_ee6c, 870_976), (0x74b6_8c4e, 375_488)];
 
 #[test]
@@ -205,6 +205,7 @@ fn files_without_a_placement_are_unchanged_1_0_files() {
         hull_min_faces: 1,
         hull_max_points: u32::MAX,
         model_axes: false,
+        split_by_volume: false,
         ..BuildOptions::default()
     };
     let options = [

@@ -128,6 +128,7 @@ def build(
     hull_min_faces: Optional[int] = None,
     hull_max_points: Optional[int] = None,
     model_axes: bool = True,
+    split_by_volume: bool = True,
     sphere_fit: str = "box-centre",
     force: bool = False,
 ) -> Tree:
@@ -152,7 +153,8 @@ def build(
     (0.001: millimetres to metres); ``center`` moves the bounding-box centre to the
     origin (both recorded in ``info["placement"]``; queries work in stored units);
     ``fit`` "hull", "triangles" or "vertices"; ``hull_min_faces``, ``hull_max_points``,
-    ``model_axes`` and ``sphere_fit`` ("box-centre" or "minimal") as the CLI's flags.
+    ``model_axes``, ``split_by_volume`` and ``sphere_fit`` ("box-centre" or "minimal") as
+    the CLI's flags.
 
     Runs with the GIL released. Raises ``MeshError`` for a mesh that cannot be loaded or
     built, ``OptionError`` (a ValueError) for an option out of range, ``FileError`` (an
@@ -170,6 +172,7 @@ def build(
         hull_min_faces=hull_min_faces,
         hull_max_points=hull_max_points,
         model_axes=model_axes,
+        split_by_volume=split_by_volume,
         sphere_fit=sphere_fit,
         force=force,
     )

@@ -254,6 +254,7 @@ def _build(
     hull_min_faces: Optional[int],
     hull_max_points: Optional[int],
     model_axes: bool,
+    split_by_volume: bool,
     sphere_fit: str,
     force: bool,
 ) -> Tree: ...

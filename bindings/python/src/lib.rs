@@ -20,7 +20,7 @@ use pyo3::prelude::*;
 /// The native half of `obbtree.build` (which documents it): builds from a mesh file, or
 /// from (n, 3) float64 vertices and (m, 3) int64 faces.
 #[pyfunction]
-#[pyo3(signature = (mesh_path, vertices, faces, out, bv, precision, layout, fit, leaf_size, scale, center, hull_min_faces, hull_max_points, model_axes, sphere_fit, force))]
+#[pyo3(signature = (mesh_path, vertices, faces, out, bv, precision, layout, fit, leaf_size, scale, center, hull_min_faces, hull_max_points, model_axes, split_by_volume, sphere_fit, force))]
 #[allow(clippy::too_many_arguments)]
 fn _build(
     py: Python<'_>,
@@ -38,6 +38,7 @@ fn _build(
     hull_min_faces: Option<u32>,
     hull_max_points: Option<u32>,
     model_axes: bool,
+    split_by_volume: bool,
     sphere_fit: &str,
     force: bool,
 ) -> PyResult<tree::Tree> {
@@ -52,6 +53,7 @@ fn _build(
         hull_min_faces,
         hull_max_points,
         model_axes,
+        split_by_volume,
         sphere_fit,
     )?;
     let source = match (mesh_path, vertices, faces) {

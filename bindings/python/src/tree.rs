@@ -310,6 +310,7 @@ pub fn build_options(
     hull_min_faces: Option<u32>,
     hull_max_points: Option<u32>,
     model_axes: bool,
+    split_by_volume: bool,
     sphere_fit: &str,
 ) -> Result<BuildOptions, Failure> {
     let default = BuildOptions::default();
@@ -357,6 +358,7 @@ pub fn build_options(
         hull_min_faces: hull_min_faces.unwrap_or(default.hull_min_faces),
         hull_max_points: hull_max_points.unwrap_or(default.hull_max_points),
         model_axes,
+        split_by_volume,
     };
     options.validate()?;
     Ok(options)

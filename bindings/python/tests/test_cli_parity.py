@@ -52,6 +52,16 @@ def test_build_options_match_cli(tmp_path):
     assert out_py.read_bytes() == out_cli.read_bytes()
 
 
+def test_split_by_volume_off_matches_cli(tmp_path):
+    out_cli, out_py = tmp_path / "cli.obbt", tmp_path / "py.obbt"
+    run_cli("build", COW_OBJ, "-o", out_cli, "--split-by-volume", "no", "--model-axes", "no",
+            "--quiet")
+    obbtree.build(COW_OBJ, out_py, split_by_volume=False, model_axes=False)
+    assert out_py.read_bytes() == out_cli.read_bytes()
+    obbtree.build(COW_OBJ, tmp_path / "default.obbt")
+    assert out_py.read_bytes() != (tmp_path / "default.obbt").read_bytes()
+
+
 def test_verify_ok(trees):
     out = run_cli("verify", trees["cow_f32"]).stdout
     assert "ok" in out
