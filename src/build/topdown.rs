@@ -353,9 +353,13 @@ fn fit_and_split<B: BoundingVolume>(
 /// well on the benchmark meshes.) An axis that would leave a side empty is not chosen.
 fn split_axis(positions: &[[f64; 3]], faces: &[[u32; 3]], axes: [[f64; 3]; 3]) -> [f64; 3] {
     let [first, ..] = axes;
-    // Each face's corners projected on each axis: `[axis][corner]`.
+    // A face's corners projected on each axis: their sum (the centroid's, times 3), least
+    // and greatest.
     let project = |face: &[u32; 3]| {
-        axes.map(|axis| face.map(|v| positions.get(v as usize).map_or(0.0, |&p| dot(axis, p))))
+        axes.map(|axis| {
+            let [x, y, z] = face.map(|v| positions.get(v as usize).map_or(0.0, |&p| dot(axis, p)));
+            (x + y + z, x.min(y).min(z), x.max(y).max(z))
+        })
     };
     // The mean centroid projected (times 3, as the corners' sums below): one pass of sums.
     let mut corners_sum = [0.0; 3];
@@ -374,21 +378,24 @@ fn split_axis(positions: &[[f64; 3]], faces: &[[u32; 3]], axes: [[f64; 3]; 3]) -
     let mut hi = [[[f64::NEG_INFINITY; 3]; 2]; 3];
     let mut count = [[0usize; 2]; 3];
     for face in faces {
-        let corners = project(face);
-        for (c, ((lo, hi), count)) in lo.iter_mut().zip(&mut hi).zip(&mut count).enumerate() {
-            let centroid: f64 = corners.get(c).map_or(0.0, |x| x.iter().sum());
-            let side = usize::from(centroid >= mean.get(c).copied().unwrap_or(0.0));
+        let along = project(face);
+        for ((((lo, hi), count), (centroid, _, _)), mean) in lo
+            .iter_mut()
+            .zip(&mut hi)
+            .zip(&mut count)
+            .zip(&along)
+            .zip(&mean)
+        {
+            let side = usize::from(*centroid >= *mean);
             let (Some(lo), Some(hi), Some(n)) =
                 (lo.get_mut(side), hi.get_mut(side), count.get_mut(side))
             else {
                 continue;
             };
             *n += 1;
-            for ((l, h), x) in lo.iter_mut().zip(hi.iter_mut()).zip(&corners) {
-                for &x in x {
-                    *l = l.min(x);
-                    *h = h.max(x);
-                }
+            for ((l, h), (_, least, greatest)) in lo.iter_mut().zip(hi.iter_mut()).zip(&along) {
+                *l = l.min(*least);
+                *h = h.max(*greatest);
             }
         }
     }
