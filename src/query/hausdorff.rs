@@ -1209,13 +1209,8 @@ mod tests {
     /// pseudo-random corner distances.
     #[test]
     fn the_envelope_peak_is_the_largest_value_over_the_piece() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::generate::Rng::new(7);
+        let mut next = move || rng.unit();
         const N: u32 = 60;
         for case in 0..300 {
             let count = 1 + case % 5;
