@@ -89,7 +89,8 @@ pub struct HausdorffResult {
     /// A proven bound the true distance does not exceed (rounding aside): at most the
     /// error asked above `distance`, or with errors 0 a few ulps of the models'
     /// coordinates (exact to f64 rounding) where the bounds close before the floor of the
-    /// refinement (see [`HausdorffOptions::rel_err`]), the gap left at the floor otherwise.
+    /// refinement, the gap left at the floor otherwise; an allowance below 2⁻²⁴ of the
+    /// diagonal also stops at the floor (see [`HausdorffOptions::rel_err`]).
     pub upper_bound: f64,
     /// Which one-sided distance the witness realises.
     pub direction: HausdorffDirection,
@@ -116,10 +117,11 @@ pub struct HausdorffResult {
 /// descents. (At 2⁻²⁴ a fuzzed ridge of a few triangles took half a minute.)
 const FLOOR: f64 = 1.0 / (1u64 << 16) as f64;
 
-/// The least error, as a fraction of the measured model's bounding-box diagonal, that
-/// splitting goes below [`FLOOR`] to meet. Near-coincident surfaces triangulated
-/// differently have bounds that close only linearly, and h about 0: a relative error of
-/// that is an absolute one too fine to reach.
+/// The least error allowed, as a fraction of the measured model's bounding-box diagonal,
+/// that splitting goes below [`FLOOR`] to meet (a small `abs_err`, or a small `rel_err` of
+/// a small h). The case it is for: near-coincident surfaces triangulated differently have
+/// bounds that close only linearly, and h about 0, so a relative error of that is an
+/// absolute one too fine to reach.
 const FINEST: f64 = 1.0 / (1u64 << 24) as f64;
 
 /// The Hausdorff distance from `a` posed by `pose_a` to `b` posed by `pose_b` (world
@@ -574,11 +576,11 @@ fn interpolated_envelope(distances: &[Vector3<f64>]) -> (f64, Vector3<f64>) {
 /// envelope's largest value over the piece is found exactly. Over the part of the piece
 /// nearest one `q_i` the envelope is that point's distance, convex, so it peaks at a vertex
 /// of that part: a corner of the piece, where an edge crosses the bisector of two points,
-/// or where the bisectors of three points cross the piece's plane. Where the nearest
-/// triangle of B changes inside the piece, the convexity bound closes only linearly with
-/// the piece's size and this one quadratically: a point moved by `s` along a face of B
-/// gets farther from the measured point by about `s² / 2d`, not `s`. Also returns where
-/// the envelope peaks: near where the true distance peaks, a good point to measure.
+/// or where the bisectors of three points cross the piece's plane. It helps where B's
+/// nearest part curves (an edge or a corner, whose distance the convexity bound
+/// overestimates between corners): a point moved by `s` along a face of B gets farther
+/// from the measured point by about `s² / 2d`, not `s`. Also returns where the envelope
+/// peaks: near where the true distance peaks, the point measured at the floor.
 fn point_bound(corners: &[Vector3<f64>; 3], points: &[Vector3<f64>]) -> (f64, Vector3<f64>) {
     let envelope = |x: &Vector3<f64>| {
         points
@@ -652,10 +654,10 @@ fn point_bound(corners: &[Vector3<f64>; 3], points: &[Vector3<f64>]) -> (f64, Ve
 /// it. While the bound is above `threshold`, points inside are measured ([`PROBES`]), each
 /// adding its nearest triangle to the candidates and its nearest point to the
 /// nearest-points bound: the centroid (the triangle nearest the middle often bounds a piece
-/// whose corners each see another: a corner of A shared by several triangles of B), where
-/// the convexity bound peaks (on a ridge between two faces of B, the ridge itself: the
-/// distance there is the bound, and measuring it closes the piece), and where the
-/// nearest-points bound peaks (near a ridge where B curves: an edge or a vertex nearest).
+/// whose corners each see another: a corner of A shared by several triangles of B), then
+/// where the convexity bound peaks (on a ridge between two faces of B, the ridge itself:
+/// the distance there is the bound, and measuring it closes the piece). (A third probe at
+/// the nearest-points bound's peak cost more descents than it saved on the test meshes.)
 fn bounded_piece<B: BoundingVolume>(
     tree: &TreeView<'_, B>,
     corners: [Vector3<f64>; 3],
@@ -687,13 +689,11 @@ fn bounded_piece<B: BoundingVolume>(
         if upper <= threshold {
             break;
         }
-        let x = match probe {
-            0 => (corners[0] + corners[1] + corners[2]) / 3.0,
-            1 => {
-                let (_, l) = candidates.bound();
-                corners[0] * l.x + corners[1] * l.y + corners[2] * l.z
-            }
-            _ => bound(&points, measured).1,
+        let x = if probe == 0 {
+            (corners[0] + corners[1] + corners[2]) / 3.0
+        } else {
+            let (_, l) = candidates.bound();
+            corners[0] * l.x + corners[1] * l.y + corners[2] * l.z
         };
         let m = self::near(tree, &x, Some(seed), heap, work)?;
         seed = m.face;
@@ -760,8 +760,8 @@ struct Ball {
     kind: NodeKind,
 }
 
-/// The points measured inside a piece whose corners leave its bound open: see
-/// [`bounded_piece`].
+/// The points measured inside a piece whose corners leave its bound open, the centroid and
+/// the convexity bound's peak: see [`bounded_piece`].
 const PROBES: usize = 2;
 
 /// One vertex in this many is measured before the nodes of `from` are culled, for a first
@@ -1102,84 +1102,110 @@ fn bound<B: BoundingVolume>(
         }
     }
     let mut scratch = BinaryHeap::new();
-    while let Some(piece) = heap.pop() {
-        if piece.upper <= enough(witness.near.distance) {
-            // No piece left can raise the lower bound by more than the error allowed.
-            upper = upper.max(piece.upper);
-            break;
-        }
+    let longest = |piece: &Piece| {
         let [p0, p1, p2] = piece.corners;
-        let longest = (p1 - p0).norm().max((p2 - p1).norm()).max((p0 - p2).norm());
-        if longest <= floor(witness.near.distance) {
-            // Split no further; where the nearest-points bound peaks is where the distance
-            // most likely does (across a ridge between two triangles' regions of B, the
-            // corners and middles sampled so far fall short of it linearly).
-            let (_, peak) = point_bound(&piece.corners, &piece.near.map(|n| n.point));
-            let n = near(
-                tree,
-                &peak,
-                Some(piece.near[0].face),
-                &mut scratch,
-                &mut work,
-            )?;
-            if n.distance > witness.near.distance {
-                witness = Witness {
-                    point: peak,
-                    near: n,
-                    triangle: piece.triangle,
-                };
+        (p1 - p0).norm().max((p2 - p1).norm()).max((p0 - p2).norm())
+    };
+    // Pieces that reached the floor: back to splitting if the allowance grows past it.
+    let mut parked: Vec<Piece> = Vec::new();
+    loop {
+        while let Some(piece) = heap.pop() {
+            if piece.upper <= enough(witness.near.distance) {
+                // No piece left can raise the lower bound by more than the error allowed.
+                upper = upper.max(piece.upper);
+                heap.clear();
+                break;
             }
-            upper = upper.max(piece.upper);
-            continue;
-        }
-        work.nodes_visited += 1;
-        let [n0, n1, n2] = piece.near;
-        let mut midpoint = |a: &Vector3<f64>, b: &Vector3<f64>, seed: &Near| {
-            let m = (a + b) / 2.0;
-            near(tree, &m, Some(seed.face), &mut scratch, &mut work).map(|n| (m, n))
-        };
-        let (m01, k01) = midpoint(&p0, &p1, &n0)?;
-        let (m12, k12) = midpoint(&p1, &p2, &n1)?;
-        let (m20, k20) = midpoint(&p2, &p0, &n2)?;
-        for (m, k) in [(m01, k01), (m12, k12), (m20, k20)] {
-            if k.distance > witness.near.distance {
-                witness = Witness {
-                    point: m,
-                    near: k,
-                    triangle: piece.triangle,
-                };
-            }
-        }
-        for (corners, near) in [
-            ([p0, m01, m20], [n0, k01, k20]),
-            ([m01, p1, m12], [k01, n1, k12]),
-            ([m20, m12, p2], [k20, k12, n2]),
-            ([m01, m12, m20], [k01, k12, k20]),
-        ] {
-            let threshold = enough(witness.near.distance);
-            let (child, middle) = bounded_piece(
-                tree,
-                corners,
-                near,
-                piece.triangle,
-                threshold,
-                (&mut scratch, &mut work),
-            )?;
-            if let Some((c, n)) = middle {
+            if longest(&piece) <= floor(witness.near.distance) {
+                // Split no further; where the nearest-points bound peaks is where the distance
+                // most likely does (where B's nearest part curves, the corners and middles
+                // sampled so far fall short of it).
+                let (_, peak) = point_bound(&piece.corners, &piece.near.map(|n| n.point));
+                let n = near(
+                    tree,
+                    &peak,
+                    Some(piece.near[0].face),
+                    &mut scratch,
+                    &mut work,
+                )?;
                 if n.distance > witness.near.distance {
                     witness = Witness {
-                        point: c,
+                        point: peak,
                         near: n,
                         triangle: piece.triangle,
                     };
                 }
+                parked.push(piece);
+                continue;
             }
-            if child.upper > enough(witness.near.distance) {
-                heap.push(child);
-            } else {
-                upper = upper.max(child.upper);
+            work.nodes_visited += 1;
+            let [p0, p1, p2] = piece.corners;
+            let [n0, n1, n2] = piece.near;
+            let mut midpoint = |a: &Vector3<f64>, b: &Vector3<f64>, seed: &Near| {
+                let m = (a + b) / 2.0;
+                near(tree, &m, Some(seed.face), &mut scratch, &mut work).map(|n| (m, n))
+            };
+            let (m01, k01) = midpoint(&p0, &p1, &n0)?;
+            let (m12, k12) = midpoint(&p1, &p2, &n1)?;
+            let (m20, k20) = midpoint(&p2, &p0, &n2)?;
+            for (m, k) in [(m01, k01), (m12, k12), (m20, k20)] {
+                if k.distance > witness.near.distance {
+                    witness = Witness {
+                        point: m,
+                        near: k,
+                        triangle: piece.triangle,
+                    };
+                }
+            }
+            for (corners, near) in [
+                ([p0, m01, m20], [n0, k01, k20]),
+                ([m01, p1, m12], [k01, n1, k12]),
+                ([m20, m12, p2], [k20, k12, n2]),
+                ([m01, m12, m20], [k01, k12, k20]),
+            ] {
+                let threshold = enough(witness.near.distance);
+                let (child, middle) = bounded_piece(
+                    tree,
+                    corners,
+                    near,
+                    piece.triangle,
+                    threshold,
+                    (&mut scratch, &mut work),
+                )?;
+                if let Some((c, n)) = middle {
+                    if n.distance > witness.near.distance {
+                        witness = Witness {
+                            point: c,
+                            near: n,
+                            triangle: piece.triangle,
+                        };
+                    }
+                }
+                if child.upper > enough(witness.near.distance) {
+                    heap.push(child);
+                } else {
+                    upper = upper.max(child.upper);
+                }
             }
         }
+        // A piece parked under a small allowance (below `FINEST`) splits on once the lower
+        // bound has grown the allowance past its size.
+        let lower = witness.near.distance;
+        for piece in std::mem::take(&mut parked) {
+            if piece.upper <= enough(lower) {
+                upper = upper.max(piece.upper);
+            } else if longest(&piece) > floor(lower) {
+                heap.push(piece);
+            } else {
+                parked.push(piece);
+            }
+        }
+        if heap.is_empty() {
+            break;
+        }
+    }
+    for piece in &parked {
+        upper = upper.max(piece.upper);
     }
     Ok(Local {
         distance: witness.near.distance,

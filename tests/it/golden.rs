@@ -107,8 +107,8 @@ fn answers(file: &ObbtFile) -> Value {
 
 /// The Hausdorff answers are proven intervals, `[hausdorff, hausdorff_upper]`, which an
 /// exact query may narrow where its bounds close before the floor of its refinement (the
-/// answer of a later obbtree is then better, not different): each recorded interval must
-/// meet the one found now, since both hold the true distance. Taken out of both answers.
+/// answer of a later obbtree is then better, not different): the interval found must lie
+/// within the recorded one. Taken out of both answers.
 fn same_hausdorff(found: &mut Value, recorded: &mut Value) -> bool {
     let interval = |v: &mut Value| {
         let mut take = |key| {
@@ -121,7 +121,7 @@ fn same_hausdorff(found: &mut Value, recorded: &mut Value) -> bool {
     };
     let ((lo, hi), (then_lo, then_hi)) = (interval(found), interval(recorded));
     let slack = 1e-12 * hi.max(then_hi).max(1.0);
-    lo <= hi && lo <= then_hi + slack && then_lo <= hi + slack
+    lo <= hi && then_lo <= lo + slack && hi <= then_hi + slack
 }
 
 /// Numbers equal to 1e-12 (relative, or absolute below 1), the rest exactly.
