@@ -377,7 +377,8 @@ fn hausdorff_query(
     );
     // Within the error asked; or, where that is below 2^-24 of A's diagonal (h about 0),
     // within what the floor of the splitting leaves (pieces of 2^-16 of A's diagonal, where
-    // bounds close at least linearly).
+    // bounds close at least linearly). The query measures A's bounding box in B's frame,
+    // whose diagonal is up to √3 times the world box's.
     let (lo, hi) = world_a.iter().flatten().fold(
         (
             Vector3::repeat(f64::INFINITY),
@@ -388,7 +389,8 @@ fn hausdorff_query(
     let floor_gap = 2.0 * (hi - lo).norm() / f64::from(1u32 << 16);
     assert!(
         h.upper_bound <= h.distance * (1.0 + HAUSDORFF_REL_ERR) + eps
-            || (HAUSDORFF_REL_ERR * h.distance < (hi - lo).norm() / f64::from(1u32 << 24)
+            || (HAUSDORFF_REL_ERR * h.distance
+                < 3f64.sqrt() * (hi - lo).norm() / f64::from(1u32 << 24)
                 && h.upper_bound <= h.distance + floor_gap + eps),
         "bounds further apart than asked: {h:?}"
     );
