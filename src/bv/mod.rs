@@ -647,6 +647,16 @@ pub(crate) fn posed_box_aabb(
     }
 }
 
+/// A random rotation and a translation at the origin, about 1, or about 1e6 away (by
+/// `k % 3`): the poses the world-box tests of the volumes take, far ones whose rounding is
+/// many times a volume's own ulps.
+#[cfg(test)]
+pub(crate) fn turned_far_pose(rng: &mut crate::generate::Rng, k: usize) -> Pose {
+    let far = [0.0, 1.0, 1e6][k % 3];
+    let t = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * far;
+    Pose::new(rng.uniform_rotation(), t).unwrap_or_default()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -659,9 +669,7 @@ mod tests {
     fn posed_box_aabb_holds_every_posed_corner() {
         let mut rng = Rng::new(3);
         for k in 0..2000 {
-            let far = [0.0, 1.0, 1e6][k % 3];
-            let t = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * far;
-            let pose = Pose::new(rng.uniform_rotation(), t).unwrap_or_default();
+            let pose = turned_far_pose(&mut rng, k);
             let axes = rng.uniform_rotation().transpose();
             let center = Vector3::new(rng.signed(), rng.signed(), rng.signed());
             let half = Vector3::new(rng.unit(), rng.unit(), rng.unit());

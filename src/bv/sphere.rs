@@ -261,15 +261,13 @@ mod tests {
     fn world_aabb_holds_the_posed_sphere() {
         let mut rng = Rng::new(11);
         for k in 0..2000 {
-            let far = [0.0, 1.0, 1e6][k % 3];
-            let t = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * far;
-            let pose = Pose::new(rng.uniform_rotation(), t).unwrap_or_default();
+            let pose = crate::bv::turned_far_pose(&mut rng, k);
             // Centres near the origin, or placed so that the posed centre is near it.
             let local = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 1e6;
             let center = if k % 2 == 0 {
                 local
             } else {
-                pose.rotation().transpose() * (local - t)
+                pose.rotation().transpose() * (local - pose.translation_vector())
             };
             let s = Sphere::<f64> {
                 center: center.into(),
