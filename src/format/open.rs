@@ -15,8 +15,10 @@ use crate::placement::Placement;
 use crate::real::Precision;
 use crate::stats::{level_stats, LevelStats, TreeShape, TreeStats};
 use crate::tree::{Encoding, NodeDefect, TreeView, VARIABLE_MAX_LEAF_FACES};
+use std::any::Any;
 use std::ops::Range;
 use std::path::Path;
+use std::sync::{Arc, Mutex};
 use zerocopy::{FromBytes, FromZeros};
 
 /// Where the bytes live. Both are 64-byte aligned and immutable for the file's lifetime.
@@ -40,7 +42,14 @@ impl Backing {
 pub struct ObbtFile {
     backing: Backing,
     meta: Meta,
+    derived: Derived,
 }
+
+/// Data that queries derive from a file's arrays (the ray index), made at first use and
+/// kept while the file is open, one value per type: the arrays never change, so neither
+/// does what is made of them.
+#[derive(Default)]
+struct Derived(Mutex<Vec<Arc<dyn Any + Send + Sync>>>);
 
 /// What `open` learned from the header and directory, checked and decoded once; every
 /// accessor reads it from here.
@@ -582,7 +591,36 @@ impl ObbtFile {
             return Err(FormatError::Misaligned);
         }
         let meta = check_header(bytes)?;
-        Ok(ObbtFile { backing, meta })
+        Ok(ObbtFile {
+            backing,
+            meta,
+            derived: Derived::default(),
+        })
+    }
+
+    /// The value of type `T` derived from this file by `make`: made at the first call for
+    /// `T` and shared by every later one (concurrent first calls may each make one; one is
+    /// kept). An error is returned and nothing kept.
+    pub(crate) fn derived<T: Any + Send + Sync, E>(
+        &self,
+        make: impl FnOnce() -> Result<T, E>,
+    ) -> Result<Arc<T>, E> {
+        let find = |made: &[Arc<dyn Any + Send + Sync>]| {
+            made.iter().find_map(|v| Arc::clone(v).downcast::<T>().ok())
+        };
+        // (A panic elsewhere while holding the lock leaves the list as valid as before.)
+        let lock = || self.derived.0.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(value) = find(&lock()) {
+            return Ok(value);
+        }
+        // Made without the lock, so that other derived data stays available meanwhile.
+        let value = Arc::new(make()?);
+        let mut made = lock();
+        if let Some(first) = find(&made) {
+            return Ok(first);
+        }
+        made.push(Arc::clone(&value) as Arc<dyn Any + Send + Sync>);
+        Ok(value)
     }
 }
 
@@ -844,4 +882,29 @@ fn check_header(bytes: &[u8]) -> Result<Meta, FormatError> {
         node,
         required: ranges,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn derived_data_is_made_once_per_type_and_errors_are_not_kept() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt");
+        let file = ObbtFile::open(path).expect("opens");
+        let made = AtomicUsize::new(0);
+        let make = |value: u64| {
+            made.fetch_add(1, Ordering::Relaxed);
+            Ok::<u64, &str>(value)
+        };
+        let first = file.derived(|| make(7)).expect("made");
+        let again = file.derived(|| make(8)).expect("kept");
+        assert!(Arc::ptr_eq(&first, &again));
+        assert_eq!((*again, made.load(Ordering::Relaxed)), (7, 1));
+        // Another type is another value; a failed make leaves nothing behind.
+        assert_eq!(file.derived(|| Err::<u32, _>("no")), Err("no"));
+        assert_eq!(file.derived(|| Ok::<u32, &str>(3)).map(|v| *v), Ok(3));
+        assert_eq!(*file.derived(|| make(9)).expect("kept"), 7);
+    }
 }

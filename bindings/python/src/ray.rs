@@ -68,20 +68,23 @@ pub fn _ray<'py>(
             .into())
         }
     };
-    // Each ray's hits, in ray order.
-    let hits: Vec<Vec<RayHit>> = detached(py, threads, || -> Result<_, Failure> {
+    // The hits with their rays' indices, in ray order (no vector per ray: for one hit
+    // per ray, those allocations would cost as much as the rays).
+    let hits: Vec<(usize, RayHit)> = detached(py, threads, || -> Result<_, Failure> {
         Ok(match mode {
             Some(mode) => cast_rays(&file, &pose, &rays, &RayOptions { mode, t_max })?
                 .into_iter()
-                .map(|r| r.hit.into_iter().collect())
+                .enumerate()
+                .filter_map(|(i, r)| Some((i, r.hit?)))
                 .collect(),
             None => all_ray_hits(&file, &pose, &rays, t_max)?
                 .into_iter()
-                .map(|r| r.hits)
+                .enumerate()
+                .flat_map(|(i, r)| r.hits.into_iter().map(move |h| (i, h)))
                 .collect(),
         })
     })?;
-    let m = hits.iter().map(Vec::len).sum();
+    let m = hits.len();
     let (mut ray, mut t, mut tri, mut bary, mut normal) = (
         Vec::with_capacity(m),
         Vec::with_capacity(m),
@@ -89,14 +92,12 @@ pub fn _ray<'py>(
         Vec::with_capacity(3 * m),
         Vec::with_capacity(3 * m),
     );
-    for (index, hits) in hits.iter().enumerate() {
-        for h in hits {
-            ray.push(index as i64);
-            t.push(h.t);
-            tri.push(i64::from(h.triangle));
-            bary.extend(h.barycentric);
-            normal.extend(h.normal);
-        }
+    for (index, h) in hits {
+        ray.push(index as i64);
+        t.push(h.t);
+        tri.push(i64::from(h.triangle));
+        bary.extend(h.barycentric);
+        normal.extend(h.normal);
     }
     Ok((
         PyArray1::from_vec(py, ray),

@@ -79,7 +79,7 @@ impl RaySpace {
     /// triangles around it.
     #[inline]
     pub fn intersect(&self, t: &Triangle, t_max: f64) -> Option<RayTriangleHit> {
-        let [a, b, c] = t.map(|p| self.sheared(&p));
+        let [a, b, c] = crate::arr3::map(*t, |p| self.sheared(&p));
         // Each function is twice the signed area the origin makes with an edge, so the one
         // of the edge opposite a corner is that corner's weight.
         let u = cross(&c, &b);

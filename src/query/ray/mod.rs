@@ -1,16 +1,20 @@
 //! Rays against one posed model: the closest hit, any hit, or every hit, by a front-to-back
-//! descent of one tree pruned by where each volume's slab the ray enters.
+//! descent of the model's ray index ([`index`]) pruned by where the ray enters each box.
 
-use super::engine::{corrupt, triangle};
+mod index;
+
+use super::engine::corrupt;
 use super::triangle::{RaySpace, Triangle};
 use super::{source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
-use crate::tree::{NodeDefect, NodeKind, TreeView};
+use crate::tree::{NodeDefect, TreeView};
+use index::{Entered, RayIndex, Slabs};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::cmp::Ordering;
+use std::sync::Mutex;
 
 /// A ray: the points `origin + t · direction` for `t ≥ 0`, world frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -230,10 +234,9 @@ impl Collect for All {
     }
 }
 
-/// A ray mapped into the model's frame, ready for volume and triangle tests.
+/// A ray mapped into the model's frame, ready for box and triangle tests.
 struct LocalRay<'a> {
-    origin: [f64; 3],
-    direction: [f64; 3],
+    slabs: Slabs,
     space: RaySpace,
     /// Model to world, for the normals.
     pose: &'a Pose,
@@ -261,6 +264,7 @@ fn run<C: Collect>(
     }
     /// The typed descent, run for every ray.
     struct Visit<'q, F> {
+        model: &'q ObbtFile,
         pose: &'q Pose,
         rays: &'q [Ray],
         t_max: f64,
@@ -269,35 +273,55 @@ fn run<C: Collect>(
     impl<C: Collect, F: Fn() -> C + Sync> TreeVisitor for Visit<'_, F> {
         type Output = Result<Vec<C::Output>, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
+            let ray_index = self.model.derived(|| RayIndex::build(&tree))?;
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
-            self.rays
-                .par_iter()
-                .enumerate()
-                .map_init(Vec::new, |stack, (index, ray)| {
-                    let origin = to_model.apply(&Vector3::from(ray.origin));
-                    let direction = to_model.rotation() * Vector3::from(ray.direction);
-                    // (Only a direction so short that turning it underflows fails here.)
-                    let space = RaySpace::new(&origin, &direction).ok_or(QueryError::BadInput {
+            let answer = |stack: &mut Vec<Entered>, index: usize, ray: &Ray| {
+                let origin = to_model.apply(&Vector3::from(ray.origin));
+                let direction = to_model.rotation() * Vector3::from(ray.direction);
+                // (Only a direction so short that turning it underflows fails here.)
+                let space =
+                    RaySpace::new(&origin, &direction).ok_or_else(|| QueryError::BadInput {
                         what: "ray",
                         index,
                         requirement: "direction must be longer",
                         value: direction.norm(),
                     })?;
-                    let local = LocalRay {
-                        origin: origin.into(),
-                        direction: direction.into(),
-                        space,
-                        pose: self.pose,
-                    };
-                    let mut collect = (self.make)();
-                    let work = descend(&tree, &local, self.t_max, stack, &mut collect)?;
-                    Ok(collect.finish(work))
+                let local = LocalRay {
+                    slabs: Slabs::new(origin.into(), direction.into()),
+                    space,
+                    pose: self.pose,
+                };
+                let mut collect = (self.make)();
+                let work = descend(&ray_index, &tree, &local, self.t_max, stack, &mut collect)?;
+                Ok(collect.finish(work))
+            };
+            // Answers go straight into one vector (collecting results would copy them
+            // through a list of chunks, a cost the size of the answers); the error of the
+            // first ray that fails is kept aside.
+            let failed: Mutex<Option<(usize, QueryError)>> = Mutex::new(None);
+            let mut answers = Vec::new();
+            self.rays
+                .par_iter()
+                .enumerate()
+                .map_init(Vec::new, |stack, (index, ray)| {
+                    answer(stack, index, ray).unwrap_or_else(|error| {
+                        let mut failed = failed.lock().unwrap_or_else(|p| p.into_inner());
+                        if failed.as_ref().is_none_or(|(first, _)| index < *first) {
+                            *failed = Some((index, error));
+                        }
+                        (self.make)().finish(Work::default())
+                    })
                 })
-                .collect()
+                .collect_into_vec(&mut answers);
+            match failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+                Some((_, error)) => Err(error),
+                None => Ok(answers),
+            }
         }
     }
     model.visit(Visit {
+        model,
         pose,
         rays,
         t_max,
@@ -326,76 +350,67 @@ fn check_ray(index: usize, ray: &Ray) -> Result<(), QueryError> {
     Ok(())
 }
 
-/// How far past the horizon a volume may be entered and still be opened: the entry is a
+/// How far past the horizon a box may be entered and still be opened: the entry is a
 /// bound on exact parameters, a triangle's `t` is rounded, and a triangle at the horizon
 /// must still be found to break a tie by its id.
 const PRUNE_MARGIN: f64 = 64.0 * f64::EPSILON;
 
-/// Front to back: a node's children are tested when it is expanded and those the ray
-/// enters wait on the stack, the nearest on top; a node taken whose entry lies past the
-/// horizon is pruned. Each volume test counts once, in D or I.
+/// Front to back through the ray index: a node's child boxes are tested when it is
+/// opened, the descent goes on into the nearest the ray enters and the others wait on the
+/// stack; a child taken whose entry lies past the horizon is pruned. Each box test counts
+/// once, in D or I (the root, which has no box, as one entered).
 fn descend<B: BoundingVolume, C: Collect>(
+    index: &RayIndex,
     tree: &TreeView<'_, B>,
     ray: &LocalRay,
     t_max: f64,
-    stack: &mut Vec<(f64, u32)>,
+    stack: &mut Vec<Entered>,
     collect: &mut C,
 ) -> Result<Work, QueryError> {
+    let missing = || corrupt(Side::A, NodeDefect::Missing);
     let mut work = Work::default();
     stack.clear();
-    let root = tree
-        .node(0)
-        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
     work.nodes_visited += 1;
-    match root.bv.ray_entry(ray.origin, ray.direction, t_max) {
-        Some(entry) => stack.push((entry, 0)),
-        None => work.bv_disjoint += 1,
-    }
-    while let Some((entry, node)) = stack.pop() {
+    let mut next = Some(Entered {
+        entry: 0.0,
+        start: 0,
+        count: 0,
+    });
+    while let Some(taken) = next.take().or_else(|| stack.pop()) {
         let horizon = collect.horizon(t_max);
         let reach = horizon + horizon * PRUNE_MARGIN;
-        if entry > reach {
+        if taken.entry > reach {
             work.bv_disjoint += 1;
             continue;
         }
         work.bv_overlap += 1;
-        match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
-            NodeKind::Faces(faces) => {
-                for face in faces {
-                    let t = triangle(tree, face, None, Side::A)?;
-                    let Some(hit) = ray.space.intersect(&t, collect.horizon(t_max)) else {
-                        work.tri_separated += 1;
-                        continue;
-                    };
-                    work.tri_contact += 1;
-                    let hit = RayHit {
-                        t: hit.t,
-                        triangle: source_id(tree, face, Side::A)?,
-                        barycentric: hit.barycentric,
-                        normal: (ray.pose.rotation() * unit_normal(&t)).into(),
-                    };
-                    if collect.take(hit) {
-                        return Ok(work);
-                    }
-                }
-            }
-            // Children come after their parent (checked by `node_kind`): the descent
-            // ends on any file.
-            NodeKind::Children(range) => {
-                let start = stack.len();
-                for child in range {
-                    let n = tree
-                        .node(child)
-                        .ok_or_else(|| corrupt(Side::A, NodeDefect::Missing))?;
-                    work.nodes_visited += 1;
-                    match n.bv.ray_entry(ray.origin, ray.direction, reach.min(t_max)) {
-                        Some(entry) => stack.push((entry, child)),
-                        None => work.bv_disjoint += 1,
-                    }
-                }
-                if let Some(pushed) = stack.get_mut(start..) {
-                    pushed.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
-                }
+        if taken.count == 0 {
+            // Children come after their parent (as the index is made): the descent ends.
+            let node = index.node(taken.start).ok_or_else(missing)?;
+            let (entered, n, tested) = ray.slabs.entered(node, reach.min(t_max));
+            work.nodes_visited += tested as u64;
+            work.bv_disjoint += (tested - n) as u64;
+            let mut nearest_first = entered.iter().take(n);
+            next = nearest_first.next().copied();
+            stack.extend(nearest_first.rev());
+            continue;
+        }
+        let (start, count) = (taken.start as usize, taken.count as usize);
+        for i in start..start + count {
+            let (t, face) = index.triangle(i).ok_or_else(missing)?;
+            let Some(hit) = ray.space.intersect(t, collect.horizon(t_max)) else {
+                work.tri_separated += 1;
+                continue;
+            };
+            work.tri_contact += 1;
+            let hit = RayHit {
+                t: hit.t,
+                triangle: source_id(tree, face, Side::A)?,
+                barycentric: hit.barycentric,
+                normal: (ray.pose.rotation() * unit_normal(t)).into(),
+            };
+            if collect.take(hit) {
+                return Ok(work);
             }
         }
     }
