@@ -22,8 +22,10 @@
 //! dropped with its triangles, whose vertices are then never measured. Far apart models,
 //! where the distance varies little over A, lose most of their nodes near the root.
 
-use super::closest::{descend, Found, Waiting, WARM_RUN};
+use super::closest::WARM_RUN;
 use super::engine::{corrupt, triangle};
+use super::index::point::{Found, Queued};
+use super::index::SurfaceIndex;
 use super::triangle::closest_point_on_triangle;
 use super::{QueryError, Side, Work};
 use crate::bv::BoundingVolume;
@@ -318,16 +320,23 @@ fn one_sided(
     })??;
     /// The bounds, run on `to`'s typed tree.
     struct Bounds<'q> {
+        to: &'q ObbtFile,
         from: &'q FromModel,
         options: &'q HausdorffOptions,
     }
     impl TreeVisitor for Bounds<'_> {
         type Output = Result<Local, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            bound(&tree, self.from, self.options)
+            let index = self.to.derived(|| SurfaceIndex::build(&tree))?;
+            let to = To {
+                tree: &tree,
+                index: &index,
+            };
+            bound(&to, self.from, self.options)
         }
     }
     let local = to.visit(Bounds {
+        to,
         from: &from,
         options,
     })??;
@@ -368,19 +377,35 @@ struct Near {
     point: Vector3<f64>,
 }
 
+/// `to`'s tree, and its surface index, which finds the nearest points; read as the tree
+/// everywhere else.
+struct To<'a, 't, B: BoundingVolume> {
+    tree: &'a TreeView<'t, B>,
+    index: &'a SurfaceIndex,
+}
+
+impl<'t, B: BoundingVolume> std::ops::Deref for To<'_, 't, B> {
+    type Target = TreeView<'t, B>;
+    fn deref(&self) -> &Self::Target {
+        self.tree
+    }
+}
+
 /// The nearest point of `to` to `p`, the search started from `seed`.
 fn near<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+    tree: &To<'_, '_, B>,
     p: &Vector3<f64>,
     seed: Option<u32>,
-    heap: &mut BinaryHeap<Waiting>,
+    heap: &mut BinaryHeap<Queued>,
     work: &mut Work,
 ) -> Result<Near, QueryError> {
     let Found {
         best,
         distance,
         work: done,
-    } = descend(tree, p, f64::INFINITY, seed, heap)?;
+    } = tree
+        .index
+        .nearest(tree.tree, p, f64::INFINITY, seed, heap)?;
     *work += done;
     let best = best.ok_or(QueryError::CorruptTree {
         which: Side::B,
@@ -434,7 +459,7 @@ by_upper!(Piece);
 /// The distances from a piece's corners to one candidate triangle `face` of B (a corner's
 /// own nearest triangle's distance is known).
 fn corner_distances<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+    tree: &To<'_, '_, B>,
     corners: &[Vector3<f64>; 3],
     near: &[Near; 3],
     face: u32,
@@ -470,7 +495,7 @@ impl Candidates {
     /// Tries `face` too (once; beyond [`Candidates::MAX`] the bound just stays looser).
     fn add<B: BoundingVolume>(
         &mut self,
-        tree: &TreeView<'_, B>,
+        tree: &To<'_, '_, B>,
         (corners, near): (&[Vector3<f64>; 3], &[Near; 3]),
         face: u32,
         work: &mut Work,
@@ -659,12 +684,12 @@ fn point_bound(corners: &[Vector3<f64>; 3], points: &[Vector3<f64>]) -> (f64, Ve
 /// the distance there is the bound, and measuring it closes the piece). (A third probe at
 /// the nearest-points bound's peak cost more descents than it saved on the test meshes.)
 fn bounded_piece<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+    tree: &To<'_, '_, B>,
     corners: [Vector3<f64>; 3],
     near: [Near; 3],
     triangle_id: u32,
     threshold: f64,
-    (heap, work): (&mut BinaryHeap<Waiting>, &mut Work),
+    (heap, work): (&mut BinaryHeap<Queued>, &mut Work),
 ) -> Result<(Piece, Option<Measured>), QueryError> {
     let mut candidates = Candidates::default();
     for n in &near {
@@ -771,7 +796,7 @@ const SAMPLE_STRIDE: usize = 16;
 /// Measures the vertices `which` (indices into `vertices`) into `nearest`, in runs seeded as
 /// closest points are.
 fn measure<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+    tree: &To<'_, '_, B>,
     vertices: &[Vector3<f64>],
     which: &[usize],
     nearest: &mut [Option<Near>],
@@ -830,7 +855,7 @@ struct Measures<'m> {
 /// that culls the rest. (Leaves reached without a bound, as when the models nearly
 /// coincide, leave their vertices to the parallel pass after.)
 fn cull<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+    tree: &To<'_, '_, B>,
     from: &FromModel,
     enough: impl Fn(f64) -> f64,
     measures: Measures<'_>,
@@ -940,7 +965,7 @@ fn farthest(nearest: &[Option<Near>], vertices: &[Vector3<f64>], owner: &[u32]) 
 }
 
 fn bound<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
+    tree: &To<'_, '_, B>,
     from: &FromModel,
     options: &HausdorffOptions,
 ) -> Result<Local, QueryError> {

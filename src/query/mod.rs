@@ -33,6 +33,7 @@ pub mod details;
 mod distance;
 mod engine;
 mod hausdorff;
+mod index;
 mod pair_query;
 mod ray;
 mod span;

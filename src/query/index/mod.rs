@@ -1,23 +1,27 @@
-//! The ray index: an axis-aligned box hierarchy over a model's stored triangles, model
-//! frame, split by the surface area heuristic, made once per open file at its first ray
-//! query ([`ObbtFile::derived`](crate::format::ObbtFile)).
+//! The surface index: an axis-aligned box hierarchy over one model's stored triangles,
+//! model frame, split by the surface area heuristic, for the queries of one model against
+//! rays ([`ray`]) and points ([`point`]). Made once per open file at its first such query
+//! ([`ObbtFile::derived`](crate::format::ObbtFile)) and kept with it.
 //!
 //! Why a second hierarchy: the file's tree is shaped for pairs of posed models (tight
 //! oriented boxes, split for volume), where a box test is paid once per node pair. A ray
-//! tests one volume per node and is done in microseconds, so there the test's cost
-//! dominates: an axis-aligned slab test with the ray's inverse direction is a handful of
-//! operations against an oriented box's rotation and divisions, and the surface area
-//! heuristic, which minimises the expected number of boxes a random ray opens, shapes the
-//! tree for exactly this query.
+//! or a point tests one volume per node and is done in microseconds, so there the test's
+//! cost decides: an axis-aligned box against a ray's inverse direction or a point is a
+//! handful of operations against an oriented box's change of frame, four children side by
+//! side are read at once, and the surface area heuristic, which minimises the expected
+//! number of boxes a random ray opens, shapes the tree for exactly these queries.
 //!
-//! Boxes are stored in f32, rounded outward from the f64 corners, and the slab test widens
-//! its interval by its own rounding, so the descent never prunes a box the ray meets; the
+//! Boxes are stored in f32, rounded outward from the f64 corners, and each query widens
+//! its bounds by their own rounding, so no box is pruned that holds an answer; the
 //! triangles are copied in leaf order as the exact corners the tree stores, and tested by
-//! the same watertight test as before.
+//! the same exact triangle tests as before.
 
-use super::super::engine::triangle;
-use super::super::triangle::Triangle;
-use super::super::{QueryError, Side};
+pub(in crate::query) mod point;
+pub(in crate::query) mod ray;
+
+use super::engine::triangle;
+use super::triangle::Triangle;
+use super::{QueryError, Side};
 use crate::arr3;
 use crate::bv::BoundingVolume;
 use crate::tree::TreeView;
@@ -33,7 +37,7 @@ const NODE_COST: f64 = 1.0;
 
 /// Children of a node at most: a descent reads them together, so wider nodes mean fewer
 /// dependent memory reads per ray.
-pub(super) const WIDTH: usize = 4;
+const WIDTH: usize = 4;
 
 /// A child slot's `count` when the node has fewer children.
 const EMPTY: u32 = u32::MAX;
@@ -43,7 +47,7 @@ const EMPTY: u32 = u32::MAX;
 /// `start` in leaf order, or nothing ([`EMPTY`]). 128 bytes, two 64-byte lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(super) struct IndexNode {
+pub(in crate::query) struct IndexNode {
     lo: [[f32; WIDTH]; 3],
     hi: [[f32; WIDTH]; 3],
     start: [u32; WIDTH],
@@ -59,20 +63,9 @@ impl IndexNode {
     };
 }
 
-/// A child of a node the ray enters, as a descent keeps it.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Entered {
-    /// A lower bound of where the ray enters its box.
-    pub(super) entry: f64,
-    /// A node index (`count` 0), or the first of its triangles.
-    pub(super) start: u32,
-    /// Its number of triangles, 0 for a node.
-    pub(super) count: u32,
-}
-
 /// The index of one model (see the module's documentation).
 #[derive(Debug)]
-pub(super) struct RayIndex {
+pub(in crate::query) struct SurfaceIndex {
     /// Node 0 is the root; children come after their parent.
     nodes: Vec<IndexNode>,
     /// The triangles in leaf order, model frame: the stored corners, exactly.
@@ -81,16 +74,16 @@ pub(super) struct RayIndex {
     faces: Vec<u32>,
 }
 
-impl RayIndex {
+impl SurfaceIndex {
     /// Node `index`, if there is one.
     #[inline(always)]
-    pub(super) fn node(&self, index: u32) -> Option<&IndexNode> {
+    pub(in crate::query) fn node(&self, index: u32) -> Option<&IndexNode> {
         self.nodes.get(index as usize)
     }
 
     /// Leaf-order triangle `i` and its stored face index.
     #[inline(always)]
-    pub(super) fn triangle(&self, i: usize) -> Option<(&Triangle, u32)> {
+    pub(in crate::query) fn triangle(&self, i: usize) -> Option<(&Triangle, u32)> {
         Some((self.triangles.get(i)?, *self.faces.get(i)?))
     }
 
@@ -100,7 +93,9 @@ impl RayIndex {
     ///
     /// [`QueryError::CorruptTree`] for a face naming a vertex out of bounds (a damaged,
     /// unverified file).
-    pub(super) fn build<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<RayIndex, QueryError> {
+    pub(in crate::query) fn build<B: BoundingVolume>(
+        tree: &TreeView<'_, B>,
+    ) -> Result<SurfaceIndex, QueryError> {
         let count = u32::try_from(tree.faces().len()).map_err(|_| QueryError::CorruptTree {
             which: Side::A,
             what: "more faces than 32-bit indices reach",
@@ -124,7 +119,7 @@ impl RayIndex {
         for p in &prims {
             triangles.push(triangle(tree, p.face, None, Side::A)?);
         }
-        Ok(RayIndex {
+        Ok(SurfaceIndex {
             nodes,
             triangles,
             faces: prims.iter().map(|p| p.face).collect(),
@@ -472,147 +467,9 @@ fn partition(prims: &mut [Prim], left: impl Fn(&Prim) -> bool) -> usize {
     i
 }
 
-/// A ray in the model frame, set up for slab tests.
-pub(super) struct Slabs {
-    origin: [f64; 3],
-    direction: [f64; 3],
-    inverse: [f64; 3],
-}
-
-/// How much a computed slab parameter may be off, relative to itself: the difference,
-/// the inverse and the product each round once.
-const SLAB_ROUNDING: f64 = 4.0 * f64::EPSILON;
-
-impl Slabs {
-    /// The slabs of the ray `origin + t direction` (finite, direction not zero).
-    pub(super) fn new(origin: [f64; 3], direction: [f64; 3]) -> Slabs {
-        Slabs {
-            origin,
-            direction,
-            inverse: direction.map(|d| 1.0 / d),
-        }
-    }
-
-    /// Where the ray enters each child box of `node` before parameter `reach`: a lower
-    /// bound of the exact entry, or +∞ where it does not. Never +∞ for a box the ray meets
-    /// at a `t` in `[0, reach]` (of a damaged file's NaN boxes, only that it answers).
-    #[inline(always)]
-    pub(super) fn entries(&self, node: &IndexNode, reach: f64) -> [f64; WIDTH] {
-        let mut near = [0.0f64; WIDTH];
-        let mut far = [reach; WIDTH];
-        let axes = node.lo.iter().zip(&node.hi);
-        let rays = self.origin.iter().zip(&self.inverse).zip(&self.direction);
-        for ((lo, hi), ((&o, &inverse), &direction)) in axes.zip(rays) {
-            let lanes = near.iter_mut().zip(far.iter_mut()).zip(lo.iter().zip(hi));
-            if inverse.is_finite() {
-                for ((near, far), (&lo, &hi)) in lanes {
-                    let t0 = (f64::from(lo) - o) * inverse;
-                    let t1 = (f64::from(hi) - o) * inverse;
-                    let (a, b) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-                    // (Plain comparisons: NaN, of a damaged file, compares false.)
-                    if a > *near {
-                        *near = a;
-                    }
-                    if b < *far {
-                        *far = b;
-                    }
-                }
-            } else if direction == 0.0 {
-                // Parallel to the slab: outside it, the ray misses. (A direction so short
-                // that its inverse overflows prunes nothing on its axis.)
-                for ((_, far), (&lo, &hi)) in lanes {
-                    if o < f64::from(lo) || o > f64::from(hi) {
-                        *far = f64::NEG_INFINITY;
-                    }
-                }
-            }
-        }
-        // Widened by their rounding once: `x ∓ |x| r` is increasing in `x`, so this is
-        // the largest (smallest) of the widened bounds of the three slabs.
-        std::array::from_fn(|lane| {
-            let (near, far) = (near.get(lane).copied(), far.get(lane).copied());
-            let (Some(near), Some(far)) = (near, far) else {
-                return f64::INFINITY;
-            };
-            let (near, far) = (
-                near - near.abs() * SLAB_ROUNDING,
-                far + far.abs() * SLAB_ROUNDING,
-            );
-            if near <= far {
-                near
-            } else {
-                f64::INFINITY
-            }
-        })
-    }
-
-    /// The children of `node` the ray enters before `reach`, nearest first, and how many
-    /// there are; the other slots are unused.
-    #[inline(always)]
-    pub(super) fn entered(&self, node: &IndexNode, reach: f64) -> ([Entered; WIDTH], usize, usize) {
-        let entries = self.entries(node, reach);
-        let mut entered = [Entered {
-            entry: 0.0,
-            start: 0,
-            count: 0,
-        }; WIDTH];
-        let (mut n, mut tested) = (0, 0);
-        let lanes = entries.iter().zip(&node.start).zip(&node.count);
-        for ((&entry, &start), &count) in lanes {
-            if count == EMPTY {
-                continue;
-            }
-            tested += 1;
-            if entry < f64::INFINITY {
-                if let Some(slot) = entered.get_mut(n) {
-                    *slot = Entered {
-                        entry,
-                        start,
-                        count,
-                    };
-                    n += 1;
-                }
-            }
-        }
-        // Insertion sort: at most four, and a library sort is not inlined here.
-        for i in 1..n {
-            let mut j = i;
-            while j > 0 {
-                let (Some(a), Some(b)) = (entered.get(j - 1), entered.get(j)) else {
-                    break;
-                };
-                if a.entry <= b.entry {
-                    break;
-                }
-                entered.swap(j - 1, j);
-                j -= 1;
-            }
-        }
-        (entered, n, tested)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A node with one child, the box `lo`–`hi`.
-    fn node(lo: [f32; 3], hi: [f32; 3]) -> IndexNode {
-        let mut n = IndexNode::EMPTY;
-        let b = Bounds {
-            lo: lo.map(f64::from),
-            hi: hi.map(f64::from),
-        };
-        n.set(0, &b, 0, 1);
-        n
-    }
-
-    /// Where a ray enters that child, if it does.
-    fn entry(s: &Slabs, n: &IndexNode, reach: f64) -> Option<f64> {
-        let (entered, count, tested) = s.entered(n, reach);
-        assert_eq!(tested, 1);
-        (count == 1).then_some(entered[0].entry)
-    }
 
     #[test]
     fn outward_rounding_holds_the_box() {
@@ -624,55 +481,5 @@ mod tests {
         for k in 0..3 {
             assert!(f64::from(lo[k]) <= b.lo[k] && f64::from(hi[k]) >= b.hi[k]);
         }
-    }
-
-    #[test]
-    fn a_ray_along_a_face_of_the_box_enters_it() {
-        let n = node([0.0; 3], [1.0; 3]);
-        // In the plane x = 0, parallel to it: on the boundary counts as inside.
-        let s = Slabs::new([0.0, 0.5, -1.0], [0.0, 0.0, 1.0]);
-        let t = entry(&s, &n, f64::INFINITY).expect("enters");
-        assert!(t <= 1.0 && t > 1.0 - 1e-15);
-        let outside = Slabs::new([-1e-300, 0.5, -1.0], [0.0, 0.0, 1.0]);
-        assert_eq!(entry(&outside, &n, f64::INFINITY), None);
-        // Too short a direction to invert: nothing pruned on its axis.
-        let tiny = Slabs::new([-1e-300, 0.5, -1.0], [1e-310, 0.0, 1.0]);
-        assert!(entry(&tiny, &n, f64::INFINITY).is_some());
-    }
-
-    #[test]
-    fn entry_is_a_lower_bound_and_reach_prunes() {
-        let n = node([1.0, -1.0, -1.0], [2.0, 1.0, 1.0]);
-        let s = Slabs::new([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
-        let t = entry(&s, &n, f64::INFINITY).expect("enters");
-        assert!(t <= 1.0 && t > 1.0 - 1e-15);
-        assert!(entry(&s, &n, 0.5).is_none());
-        let behind = Slabs::new([3.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
-        assert!(entry(&behind, &n, f64::INFINITY).is_none());
-        let inside = Slabs::new([1.5, 0.0, 0.0], [-1.0, 0.2, 0.0]);
-        assert_eq!(entry(&inside, &n, f64::INFINITY), Some(0.0));
-    }
-
-    #[test]
-    fn children_come_nearest_first_and_empty_slots_are_not_tested() {
-        let mut n = IndexNode::EMPTY;
-        let unit = |x: f64| Bounds {
-            lo: [x, 0.0, 0.0],
-            hi: [x + 1.0, 1.0, 1.0],
-        };
-        // Boxes at x = 4, 0 and 2 along +x, and one the ray passes beside.
-        n.set(0, &unit(4.0), 10, 0);
-        n.set(1, &unit(0.0), 20, 3);
-        n.set(2, &unit(2.0), 30, 0);
-        let s = Slabs::new([-1.0, 0.5, 0.5], [1.0, 0.0, 0.0]);
-        let (entered, count, tested) = s.entered(&n, f64::INFINITY);
-        assert_eq!((count, tested), (3, 3));
-        let order: Vec<(u32, u32)> = entered[..3].iter().map(|e| (e.start, e.count)).collect();
-        assert_eq!(order, [(20, 3), (30, 0), (10, 0)]);
-        // Up to t = 4 (x = 3) the farthest box is not entered.
-        let (_, count, _) = s.entered(&n, 4.0);
-        assert_eq!(count, 2);
-        let beside = Slabs::new([-1.0, 2.0, 0.5], [1.0, 0.0, 0.0]);
-        assert_eq!(beside.entered(&n, f64::INFINITY).1, 0);
     }
 }

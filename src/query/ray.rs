@@ -1,16 +1,16 @@
 //! Rays against one posed model: the closest hit, any hit, or every hit, by a front-to-back
-//! descent of the model's ray index ([`index`]) pruned by where the ray enters each box.
-
-mod index;
+//! descent of the model's surface index ([`super::index`]) pruned by where the ray enters
+//! each box.
 
 use super::engine::corrupt;
+use super::index::ray::{Entered, Slabs};
+use super::index::SurfaceIndex;
 use super::triangle::{RaySpace, Triangle};
 use super::{source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
 use crate::tree::{NodeDefect, TreeView};
-use index::{Entered, RayIndex, Slabs};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -273,7 +273,7 @@ fn run<C: Collect>(
     impl<C: Collect, F: Fn() -> C + Sync> TreeVisitor for Visit<'_, F> {
         type Output = Result<Vec<C::Output>, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            let ray_index = self.model.derived(|| RayIndex::build(&tree))?;
+            let ray_index = self.model.derived(|| SurfaceIndex::build(&tree))?;
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
             let answer = |stack: &mut Vec<Entered>, index: usize, ray: &Ray| {
@@ -360,7 +360,7 @@ const PRUNE_MARGIN: f64 = 64.0 * f64::EPSILON;
 /// stack; a child taken whose entry lies past the horizon is pruned. Each box test counts
 /// once, in D or I (the root, which has no box, as one entered).
 fn descend<B: BoundingVolume, C: Collect>(
-    index: &RayIndex,
+    index: &SurfaceIndex,
     tree: &TreeView<'_, B>,
     ray: &LocalRay,
     t_max: f64,
