@@ -24,8 +24,8 @@
 
 use super::closest::WARM_RUN;
 use super::engine::{corrupt, triangle};
-use super::index::point::{Found, Queued};
-use super::index::SurfaceIndex;
+use super::index::point::Found;
+use super::index::{Child, SurfaceIndex};
 use super::triangle::closest_point_on_triangle;
 use super::{QueryError, Side, Work};
 use crate::bv::BoundingVolume;
@@ -396,7 +396,7 @@ fn near<B: BoundingVolume>(
     tree: &To<'_, '_, B>,
     p: &Vector3<f64>,
     seed: Option<u32>,
-    heap: &mut BinaryHeap<Queued>,
+    heap: &mut BinaryHeap<Child>,
     work: &mut Work,
 ) -> Result<Near, QueryError> {
     let Found {
@@ -689,7 +689,7 @@ fn bounded_piece<B: BoundingVolume>(
     near: [Near; 3],
     triangle_id: u32,
     threshold: f64,
-    (heap, work): (&mut BinaryHeap<Queued>, &mut Work),
+    (heap, work): (&mut BinaryHeap<Child>, &mut Work),
 ) -> Result<(Piece, Option<Measured>), QueryError> {
     let mut candidates = Candidates::default();
     for n in &near {

@@ -3,8 +3,8 @@
 //! each box.
 
 use super::engine::corrupt;
-use super::index::ray::{Entered, Slabs};
-use super::index::SurfaceIndex;
+use super::index::ray::Slabs;
+use super::index::{Child, SurfaceIndex};
 use super::triangle::{RaySpace, Triangle};
 use super::{source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
@@ -276,7 +276,7 @@ fn run<C: Collect>(
             let ray_index = self.model.derived(|| SurfaceIndex::build(&tree))?;
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
-            let answer = |stack: &mut Vec<Entered>, index: usize, ray: &Ray| {
+            let answer = |stack: &mut Vec<Child>, index: usize, ray: &Ray| {
                 let origin = to_model.apply(&Vector3::from(ray.origin));
                 let direction = to_model.rotation() * Vector3::from(ray.direction);
                 // (Only a direction so short that turning it underflows fails here.)
@@ -364,22 +364,18 @@ fn descend<B: BoundingVolume, C: Collect>(
     tree: &TreeView<'_, B>,
     ray: &LocalRay,
     t_max: f64,
-    stack: &mut Vec<Entered>,
+    stack: &mut Vec<Child>,
     collect: &mut C,
 ) -> Result<Work, QueryError> {
     let missing = || corrupt(Side::A, NodeDefect::Missing);
     let mut work = Work::default();
     stack.clear();
     work.nodes_visited += 1;
-    let mut next = Some(Entered {
-        entry: 0.0,
-        start: 0,
-        count: 0,
-    });
+    let mut next = Some(Child::ROOT);
     while let Some(taken) = next.take().or_else(|| stack.pop()) {
         let horizon = collect.horizon(t_max);
         let reach = horizon + horizon * PRUNE_MARGIN;
-        if taken.entry > reach {
+        if taken.key > reach {
             work.bv_disjoint += 1;
             continue;
         }

@@ -63,6 +63,52 @@ impl IndexNode {
     };
 }
 
+/// A child of a node that a query keeps: its key (where a ray enters its box, or the square
+/// of a lower bound of a point's distance to it), and either a node (`count` 0, `start` its
+/// index) or `count` triangles from `start` in leaf order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(in crate::query) struct Child {
+    pub(in crate::query) key: f64,
+    pub(in crate::query) start: u32,
+    pub(in crate::query) count: u32,
+}
+
+impl Child {
+    /// The root, as a child to take first.
+    pub(in crate::query) const ROOT: Child = Child {
+        key: 0.0,
+        start: 0,
+        count: 0,
+    };
+}
+
+impl IndexNode {
+    /// The children whose key (one per slot) `keep` accepts, in slot order; how many they
+    /// are; and how many children were keyed (empty slots are not).
+    #[inline(always)]
+    fn kept(
+        &self,
+        keys: [f64; WIDTH],
+        keep: impl Fn(f64) -> bool,
+    ) -> ([Child; WIDTH], usize, usize) {
+        let mut kept = [Child::ROOT; WIDTH];
+        let (mut n, mut keyed) = (0, 0);
+        for ((&key, &start), &count) in keys.iter().zip(&self.start).zip(&self.count) {
+            if count == EMPTY {
+                continue;
+            }
+            keyed += 1;
+            if keep(key) {
+                if let Some(slot) = kept.get_mut(n) {
+                    *slot = Child { key, start, count };
+                    n += 1;
+                }
+            }
+        }
+        (kept, n, keyed)
+    }
+}
+
 /// The index of one model (see the module's documentation).
 #[derive(Debug)]
 pub(in crate::query) struct SurfaceIndex {

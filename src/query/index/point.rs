@@ -1,6 +1,6 @@
 //! Points through the surface index: the nearest triangle to a point.
 
-use super::{IndexNode, SurfaceIndex, EMPTY, WIDTH};
+use super::{Child, IndexNode, SurfaceIndex, WIDTH};
 use crate::bv::BoundingVolume;
 use crate::query::engine::{corrupt, triangle};
 use crate::query::triangle::{closest_point_on_triangle, Feature, Triangle};
@@ -9,26 +9,19 @@ use crate::tree::{NodeDefect, TreeView};
 use nalgebra::Vector3;
 use std::collections::BinaryHeap;
 
-/// A child waiting in a closest-point descent, by the square of its box's distance
-/// (smallest first in a max-heap).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(in crate::query) struct Queued {
-    bound2: f64,
-    start: u32,
-    count: u32,
-}
+/// Children wait in a closest-point descent by key, the square of a lower bound of their
+/// distance to the point: smallest first in a max-heap.
+impl Eq for Child {}
 
-impl Eq for Queued {}
-
-impl PartialOrd for Queued {
+impl PartialOrd for Child {
     fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
         Some(self.cmp(other))
     }
 }
 
-impl Ord for Queued {
+impl Ord for Child {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        other.bound2.total_cmp(&self.bound2)
+        other.key.total_cmp(&self.key)
     }
 }
 
@@ -85,7 +78,7 @@ impl Found {
 /// The children of `node` nearer to `p` than `distance`, with the squares of lower
 /// bounds of their boxes' distances.
 #[inline(always)]
-fn near_children(node: &IndexNode, p: &[f64; 3], distance: f64) -> ([Queued; WIDTH], usize, usize) {
+fn near_children(node: &IndexNode, p: &[f64; 3], distance: f64) -> ([Child; WIDTH], usize, usize) {
     let mut d2 = [0.0f64; WIDTH];
     let axes = node.lo.iter().zip(&node.hi).zip(p);
     for ((lo, hi), &x) in axes {
@@ -102,33 +95,11 @@ fn near_children(node: &IndexNode, p: &[f64; 3], distance: f64) -> ([Queued; WID
             *d2 += gap * gap;
         }
     }
-    // Pruned only when surely at least as far as the best: both sides rounded apart.
+    // Pruned only when surely at least as far as the best: both sides rounded apart. (A
+    // NaN bound, of a damaged file, is kept.)
     let best2 = widened_square(distance);
-    let mut near = [Queued {
-        bound2: 0.0,
-        start: 0,
-        count: 0,
-    }; WIDTH];
-    let (mut n, mut tested) = (0, 0);
-    for ((&d2, &start), &count) in d2.iter().zip(&node.start).zip(&node.count) {
-        if count == EMPTY {
-            continue;
-        }
-        tested += 1;
-        let bound2 = d2 * (1.0 - DISTANCE_ROUNDING);
-        // (A NaN bound, of a damaged file, is kept.)
-        if bound2 < best2 || bound2.is_nan() {
-            if let Some(slot) = near.get_mut(n) {
-                *slot = Queued {
-                    bound2,
-                    start,
-                    count,
-                };
-                n += 1;
-            }
-        }
-    }
-    (near, n, tested)
+    let bounds = d2.map(|d2| d2 * (1.0 - DISTANCE_ROUNDING));
+    node.kept(bounds, |bound2| bound2 < best2 || bound2.is_nan())
 }
 
 impl SurfaceIndex {
@@ -147,7 +118,7 @@ impl SurfaceIndex {
         p: &Vector3<f64>,
         max_distance: f64,
         seed: Option<u32>,
-        heap: &mut BinaryHeap<Queued>,
+        heap: &mut BinaryHeap<Child>,
     ) -> Result<Found, QueryError> {
         let missing = || corrupt(Side::A, NodeDefect::Missing);
         let mut found = Found {
@@ -161,13 +132,9 @@ impl SurfaceIndex {
         let point = [p.x, p.y, p.z];
         heap.clear();
         found.work.nodes_visited += 1;
-        let mut dive = Some(Queued {
-            bound2: 0.0,
-            start: 0,
-            count: 0,
-        });
+        let mut dive = Some(Child::ROOT);
         while let Some(taken) = dive.take().or_else(|| heap.pop()) {
-            if taken.bound2 >= widened_square(found.distance) {
+            if taken.key >= widened_square(found.distance) {
                 // Taken from the heap: it and every one still waiting are pruned.
                 found.work.bv_disjoint += 1 + heap.len() as u64;
                 break;
@@ -191,7 +158,7 @@ impl SurfaceIndex {
             // The nearest child continues the dive; the others wait.
             for &child in near.iter().take(n) {
                 match dive {
-                    Some(d) if d.bound2 <= child.bound2 => heap.push(child),
+                    Some(d) if d.key <= child.key => heap.push(child),
                     Some(d) => {
                         heap.push(d);
                         dive = Some(child);

@@ -1,17 +1,6 @@
 //! Rays through the surface index: which children's boxes a ray enters, nearest first.
 
-use super::{IndexNode, EMPTY, WIDTH};
-
-/// A child of a node the ray enters, as a descent keeps it.
-#[derive(Clone, Copy, Debug)]
-pub(in crate::query) struct Entered {
-    /// A lower bound of where the ray enters its box.
-    pub(in crate::query) entry: f64,
-    /// A node index (`count` 0), or the first of its triangles.
-    pub(in crate::query) start: u32,
-    /// Its number of triangles, 0 for a node.
-    pub(in crate::query) count: u32,
-}
+use super::{Child, IndexNode, WIDTH};
 
 /// A ray in the model frame, set up for slab tests.
 pub(in crate::query) struct Slabs {
@@ -94,31 +83,8 @@ impl Slabs {
         &self,
         node: &IndexNode,
         reach: f64,
-    ) -> ([Entered; WIDTH], usize, usize) {
-        let entries = self.entries(node, reach);
-        let mut entered = [Entered {
-            entry: 0.0,
-            start: 0,
-            count: 0,
-        }; WIDTH];
-        let (mut n, mut tested) = (0, 0);
-        let lanes = entries.iter().zip(&node.start).zip(&node.count);
-        for ((&entry, &start), &count) in lanes {
-            if count == EMPTY {
-                continue;
-            }
-            tested += 1;
-            if entry < f64::INFINITY {
-                if let Some(slot) = entered.get_mut(n) {
-                    *slot = Entered {
-                        entry,
-                        start,
-                        count,
-                    };
-                    n += 1;
-                }
-            }
-        }
+    ) -> ([Child; WIDTH], usize, usize) {
+        let (mut entered, n, tested) = node.kept(self.entries(node, reach), |e| e < f64::INFINITY);
         // Insertion sort: at most four, and a library sort is not inlined here.
         for i in 1..n {
             let mut j = i;
@@ -126,7 +92,7 @@ impl Slabs {
                 let (Some(a), Some(b)) = (entered.get(j - 1), entered.get(j)) else {
                     break;
                 };
-                if a.entry <= b.entry {
+                if a.key <= b.key {
                     break;
                 }
                 entered.swap(j - 1, j);
@@ -157,7 +123,7 @@ mod tests {
     fn entry(s: &Slabs, n: &IndexNode, reach: f64) -> Option<f64> {
         let (entered, count, tested) = s.entered(n, reach);
         assert_eq!(tested, 1);
-        (count == 1).then_some(entered[0].entry)
+        (count == 1).then_some(entered[0].key)
     }
 
     #[test]
