@@ -145,6 +145,7 @@ pub fn winding_numbers(
     check_points(points)?;
     /// The typed descent, run for every point.
     struct Visit<'q> {
+        model: &'q ObbtFile,
         pose: &'q Pose,
         points: &'q [[f64; 3]],
         accuracy: WindingAccuracy,
@@ -152,15 +153,9 @@ pub fn winding_numbers(
     impl TreeVisitor for Visit<'_> {
         type Output = Result<Vec<WindingResult>, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            let moments = moments(&tree)?;
-            let reach: Vec<Reach> = moments
-                .iter()
-                .map(|m| Reach {
-                    centroid: m.centroid,
-                    radius: m.radius,
-                    area: m.area,
-                })
-                .collect();
+            // Made at the file's first winding query and kept with it, as the surface index.
+            let clusters = self.model.derived(|| Clusters::of(&tree))?;
+            let (moments, reach) = (&clusters.moments, &clusters.reach);
             let rule = match self.accuracy {
                 WindingAccuracy::Exact => Rule::Exact,
                 // Bound per unit area: a cluster of area A may err by A times this.
@@ -175,12 +170,13 @@ pub fn winding_numbers(
                 .par_iter()
                 .map_init(Vec::new, |stack, p| {
                     let local = to_model.apply(&Vector3::from(*p));
-                    descend(&tree, &reach, &moments, &local, rule, stack)
+                    descend(&tree, reach, moments, &local, rule, stack)
                 })
                 .collect()
         }
     }
     model.visit(Visit {
+        model,
         pose,
         points,
         accuracy: options.accuracy,
@@ -273,6 +269,27 @@ struct Reach {
     centroid: Vector3<f64>,
     radius: f64,
     area: f64,
+}
+
+/// Every node's moments, and the part of them a descent reads for every cluster it meets.
+struct Clusters {
+    moments: Vec<Moment>,
+    reach: Vec<Reach>,
+}
+
+impl Clusters {
+    fn of<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Clusters, QueryError> {
+        let moments = moments(tree)?;
+        let reach = moments
+            .iter()
+            .map(|m| Reach {
+                centroid: m.centroid,
+                radius: m.radius,
+                area: m.area,
+            })
+            .collect();
+        Ok(Clusters { moments, reach })
+    }
 }
 
 /// Every node's moment, children before parents (children follow their parent in the
