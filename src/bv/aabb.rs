@@ -122,54 +122,6 @@ impl<R: Real> BoundingVolume for Aabb<R> {
         Ok(())
     }
 
-    #[inline]
-    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
-        let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
-        // The excess past each face pair, from the stored min and max (not
-        // `box_point_distance_bound` on a centre derived from them, whose rounding is
-        // of their magnitude, not of the box's size): a few ulps of rounding.
-        let mut sum = 0.0;
-        for ((x, lo), hi) in p.iter().zip(lo).zip(hi) {
-            let excess =
-                (lo - x).max(x - hi) - 4.0 * f64::EPSILON * (x.abs() + lo.abs() + hi.abs());
-            if excess > 0.0 {
-                sum += excess * excess;
-            }
-        }
-        let bound = sum.sqrt();
-        if bound.is_nan() {
-            0.0
-        } else {
-            bound
-        }
-    }
-
-    #[inline]
-    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
-        let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
-        let (mut near, mut far) = (0.0f64, t_max);
-        for ((o, q), (lo, hi)) in arr3::zip(origin, direction)
-            .into_iter()
-            .zip(arr3::zip(lo, hi))
-        {
-            // A few ulps of slack on each face, as for the point bound.
-            let slack = 4.0 * f64::EPSILON * (o.abs() + lo.abs() + hi.abs());
-            let (lo, hi) = (lo - slack, hi + slack);
-            if q == 0.0 {
-                if o < lo || o > hi {
-                    return None;
-                }
-                continue;
-            }
-            let (t0, t1) = ((lo - o) / q, (hi - o) / q);
-            let (a, b) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-            // (`max` and `min` skip a NaN operand: a damaged box prunes nothing.)
-            near = near.max(a - 4.0 * f64::EPSILON * a.abs());
-            far = far.min(b + 4.0 * f64::EPSILON * b.abs());
-        }
-        (near <= far).then_some(near)
-    }
-
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let (lo, hi) = (point_to_f64(&self.min), point_to_f64(&self.max));
         arr3::zip(p, arr3::zip(lo, hi))

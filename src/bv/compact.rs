@@ -214,14 +214,6 @@ impl BoundingVolume for CompactObb {
             .max_distance_upper_bound(&other.decode(), b_to_a)
     }
 
-    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
-        self.decode().point_distance_lower_bound(p)
-    }
-
-    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
-        self.decode().ray_entry(origin, direction, t_max)
-    }
-
     fn world_aabb(&self, pose: &Pose) -> super::Aabb<f64> {
         self.decode().world_aabb(pose)
     }

@@ -385,17 +385,6 @@ pub trait BoundingVolume:
     /// `other` (posed as in [`BoundingVolume::overlaps`]).
     fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64;
 
-    /// A lower bound on the distance from model-frame point `p` to the volume (model units;
-    /// 0 inside): what a closest-point query prunes with. Conservative for the stored
-    /// frame's error and for rounding; 0 for a damaged volume.
-    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64;
-
-    /// The smallest ray parameter in `[0, t_max]` at which the model-frame ray
-    /// `origin + t · direction` may be inside the volume, or `None` when no point of that
-    /// segment is: what a ray query prunes and orders with. Conservative for the stored
-    /// frame's error and for rounding; never `None` for a damaged volume.
-    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64>;
-
     /// An axis-aligned box containing this volume once mapped by `pose` (a model's pose: the
     /// box is in world coordinates): the broad phase of scenes bounds each posed model by
     /// the world box of its root volume, with no traversal. Conservative: widened for the
@@ -506,89 +495,6 @@ pub fn model_axes_frame(lo: [f64; 3], hi: [f64; 3]) -> Matrix3<f64> {
     let [(_, first), (_, second), _] = order;
     let (c0, c1) = (axis(first), axis(second));
     Matrix3::from_columns(&[c0, c1, c0.cross(&c1)])
-}
-
-/// A lower bound on the distance from a point to a box: `d` the point less the box's
-/// centre, `axes` the box's axes (rows, orthonormal within `frame_error`), `half` its
-/// half-widths. For `x` in the box, `|a_i·(p − x)| ≥ |a_i·d| − h_i − frame_error·Σh`, and
-/// `|v| ≥ |A v| / (1 + 2 frame_error)`; the projections' rounding is a few ulps of their
-/// terms. NaN (a damaged, unverified file) gives 0: no bound.
-#[inline(always)]
-pub(crate) fn box_point_distance_bound(
-    d: [f64; 3],
-    axes: &[[f64; 3]; 3],
-    half: [f64; 3],
-    frame_error: f64,
-) -> f64 {
-    let half_sum = half[0] + half[1] + half[2];
-    let slack = frame_error * half_sum + 8.0 * f64::EPSILON * (l1(&d) + half_sum);
-    let mut sum = 0.0;
-    for (axis, h) in axes.iter().zip(half) {
-        let excess = arr3::dot(*axis, d).abs() - h - slack;
-        if excess > 0.0 {
-            sum += excess * excess;
-        }
-    }
-    let bound = sum.sqrt() * (1.0 - 4.0 * frame_error);
-    if bound.is_nan() {
-        0.0
-    } else {
-        bound
-    }
-}
-
-/// [`BoundingVolume::ray_entry`] of a stored box: `d` is the ray's origin less the box's
-/// centre, `axes` the stored rows, `half` the half-widths. A slab test, which needs no
-/// orthogonal axes: each slab is widened as [`box_point_distance_bound`] widens it, and by
-/// the rounding of the projections (a point of the box lies within about
-/// `|d| + Σ half` of the origin, which bounds `t · |direction|` there), and each crossing
-/// parameter by its own rounding. NaN (a damaged, unverified file) prunes nothing.
-#[inline(always)]
-pub(crate) fn box_ray_entry(
-    d: [f64; 3],
-    direction: [f64; 3],
-    axes: &[[f64; 3]; 3],
-    half: [f64; 3],
-    frame_error: f64,
-    t_max: f64,
-) -> Option<f64> {
-    let half_sum = half[0] + half[1] + half[2];
-    let slack = frame_error * half_sum + 16.0 * f64::EPSILON * (l1(&d) + half_sum);
-    // Straight-line code with plain comparisons: a ray test is a few dozen flops, and
-    // `f64::max`'s NaN handling or a loop's bookkeeping would cost as much again. A slab
-    // the ray runs parallel to gives infinite crossings (a miss when outside it) or NaN
-    // on its boundary, which the comparisons skip.
-    let slab = |axis: [f64; 3], h: f64| {
-        let (p, inverse) = (arr3::dot(axis, d), 1.0 / arr3::dot(axis, direction));
-        let h = h + slack;
-        let (t0, t1) = ((-h - p) * inverse, (h - p) * inverse);
-        if t0 < t1 {
-            (t0, t1)
-        } else {
-            (t1, t0)
-        }
-    };
-    let [(a0, b0), (a1, b1), (a2, b2)] = [
-        slab(axes[0], half[0]),
-        slab(axes[1], half[1]),
-        slab(axes[2], half[2]),
-    ];
-    let (mut near, mut far) = (0.0f64, t_max);
-    for (lo, hi) in [(a0, b0), (a1, b1), (a2, b2)] {
-        if lo > near {
-            near = lo;
-        }
-        if hi < far {
-            far = hi;
-        }
-    }
-    // Each crossing's own rounding (x ↦ x ∓ 4ε|x| is monotone, so widening the extremes
-    // widens every crossing).
-    let (near, far) = (
-        near - 4.0 * f64::EPSILON * near.abs(),
-        far + 4.0 * f64::EPSILON * far.abs(),
-    );
-    (near <= far).then_some(near.max(0.0))
 }
 
 /// Sum of absolute coordinates.

@@ -388,20 +388,6 @@ impl<R: Real> BoundingVolume for Obb<R> {
         Ok(())
     }
 
-    #[inline]
-    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
-        let d = arr3::sub(p, self.center_f64());
-        let tol = axis_tolerance(R::PRECISION);
-        super::box_point_distance_bound(d, &self.axes_f64(), self.half_f64(), tol)
-    }
-
-    #[inline(always)]
-    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
-        let d = arr3::sub(origin, self.center_f64());
-        let tol = axis_tolerance(R::PRECISION);
-        super::box_ray_entry(d, direction, &self.axes_f64(), self.half_f64(), tol, t_max)
-    }
-
     fn contains(&self, p: [f64; 3], tolerance: f64) -> bool {
         let c = self.center_f64();
         let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];

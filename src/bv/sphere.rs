@@ -130,44 +130,6 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         dot(d, d).sqrt() <= self.radius.to_f64() + tolerance
     }
 
-    /// The distance to the centre less the radius, less a few ulps of both.
-    fn point_distance_lower_bound(&self, p: [f64; 3]) -> f64 {
-        let c = point_to_f64(&self.center);
-        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-        let (length, radius) = (dot(d, d).sqrt(), self.radius.to_f64());
-        let bound = length - radius - 8.0 * f64::EPSILON * (length + radius + crate::bv::l1(&c));
-        if bound.is_nan() {
-            0.0
-        } else {
-            bound.max(0.0)
-        }
-    }
-
-    /// Where the ray enters the ball, its radius widened by a few ulps of the origin's
-    /// distance (the rounding of the point of closest approach) and of the radius.
-    fn ray_entry(&self, origin: [f64; 3], direction: [f64; 3], t_max: f64) -> Option<f64> {
-        let c = point_to_f64(&self.center);
-        let d = arr3::sub(origin, c);
-        let length = dot(d, d).sqrt();
-        let radius = self.radius.to_f64()
-            + 16.0 * f64::EPSILON * (length + self.radius.to_f64() + crate::bv::l1(&c));
-        let a = dot(direction, direction);
-        let closest = -dot(d, direction) / a;
-        let offset = arr3::map(arr3::zip(d, direction), |(d, q)| d + q * closest);
-        let slack2 = radius * radius - dot(offset, offset);
-        if slack2 < 0.0 {
-            return None;
-        }
-        let half = (slack2 / a).sqrt();
-        let widen = 8.0 * f64::EPSILON * (closest.abs() + half);
-        // (`max` and `min` skip a NaN operand: a damaged ball prunes nothing.)
-        let (near, far) = (
-            (closest - half - widen).max(0.0),
-            (closest + half + widen).min(t_max),
-        );
-        (near <= far).then_some(near)
-    }
-
     #[inline]
     fn overlaps(&self, other: &Self, b_to_a: &Pose, _guard: f64) -> bool {
         // A few ulps of slack: the mapped centre is rounded, and a sphere test must never

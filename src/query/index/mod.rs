@@ -24,6 +24,7 @@ use super::triangle::Triangle;
 use super::{QueryError, Side};
 use crate::arr3;
 use crate::bv::BoundingVolume;
+use crate::real::Real;
 use crate::tree::TreeView;
 
 /// Triangles a leaf holds at most: more are split even where the heuristic would keep them.
@@ -146,25 +147,31 @@ impl SurfaceIndex {
             which: Side::A,
             what: "more faces than 32-bit indices reach",
         })?;
-        let mut prims = Vec::with_capacity(count as usize);
-        for face in 0..count {
-            let t = triangle(tree, face, None, Side::A)?;
-            let mut bounds = Bounds::EMPTY;
-            for p in &t {
-                bounds.add(&[p.x, p.y, p.z]);
-            }
-            prims.push(Prim {
-                face,
-                bounds,
-                centre: bounds.centre(),
-            });
-        }
+        // Each stored triangle read once, in face order, then put in leaf order.
+        let stored = (0..count)
+            .map(|face| triangle(tree, face, None, Side::A))
+            .collect::<Result<Vec<Triangle>, QueryError>>()?;
+        let mut prims: Vec<Prim> = (0..count)
+            .zip(&stored)
+            .map(|(face, t)| {
+                let mut bounds = Bounds::EMPTY;
+                for p in t {
+                    bounds.add(&[p.x, p.y, p.z]);
+                }
+                Prim {
+                    face,
+                    bounds,
+                    centre: bounds.centre(),
+                }
+            })
+            .collect();
         let binary = binary_tree(&mut prims, 0);
         let nodes = widen(&binary);
-        let mut triangles = Vec::with_capacity(prims.len());
-        for p in &prims {
-            triangles.push(triangle(tree, p.face, None, Side::A)?);
-        }
+        // (Every prim's face is one of `stored`'s.)
+        let triangles = prims
+            .iter()
+            .filter_map(|p| stored.get(p.face as usize).copied())
+            .collect();
         Ok(SurfaceIndex {
             nodes,
             triangles,
@@ -359,7 +366,9 @@ impl Bounds {
         *self = self.union(&Bounds { lo: *p, hi: *p });
     }
 
-    /// The smallest box holding both (NaN coordinates skipped).
+    /// The smallest box holding both (NaN coordinates skipped). Plain comparisons rather
+    /// than `arr3::min`/`max`: this is the build's inner loop, and `f64::min`'s NaN
+    /// handling made the build about a fifth slower.
     #[inline(always)]
     fn union(&self, o: &Bounds) -> Bounds {
         let mut b = *self;
@@ -388,23 +397,10 @@ impl Bounds {
 
     /// The box in f32, rounded outward so that it holds the f64 one.
     fn outward_f32(&self) -> ([f32; 3], [f32; 3]) {
-        let down = |x: f64| {
-            let y = x as f32;
-            if f64::from(y) > x {
-                y.next_down()
-            } else {
-                y
-            }
-        };
-        let up = |x: f64| {
-            let y = x as f32;
-            if f64::from(y) < x {
-                y.next_up()
-            } else {
-                y
-            }
-        };
-        (self.lo.map(down), self.hi.map(up))
+        (
+            arr3::map(self.lo, f32::from_f64_down),
+            arr3::map(self.hi, f32::from_f64_up),
+        )
     }
 }
 
