@@ -26,7 +26,7 @@ use super::closest::WARM_RUN;
 use super::engine::{corrupt, triangle};
 use super::index::point::Found;
 use super::index::{Child, SurfaceIndex};
-use super::triangle::closest_point_on_triangle;
+use super::triangle::{closest_point_on_triangle, convex_union, Triangle};
 use super::{QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
@@ -457,14 +457,14 @@ macro_rules! by_upper {
 by_upper!(Piece);
 
 /// The distances from a piece's corners to one candidate triangle `face` of B (a corner's
-/// own nearest triangle's distance is known).
+/// own nearest triangle's distance is known), and the triangle.
 fn corner_distances<B: BoundingVolume>(
     tree: &To<'_, '_, B>,
     corners: &[Vector3<f64>; 3],
     near: &[Near; 3],
     face: u32,
     work: &mut Work,
-) -> Result<Vector3<f64>, QueryError> {
+) -> Result<(Vector3<f64>, Triangle), QueryError> {
     let t = triangle(tree, face, None, Side::B)?;
     let mut distances = Vector3::zeros();
     for ((corner, n), d) in corners.iter().zip(near).zip(distances.iter_mut()) {
@@ -476,23 +476,41 @@ fn corner_distances<B: BoundingVolume>(
             (corner - q).norm()
         };
     }
-    Ok(distances)
+    Ok((distances, t))
 }
 
 /// The triangles of B tried as a piece's nearest (those nearest its corners, its centroid
-/// and the peak of its nearest-points bound), each with its distances from the corners.
+/// and the peak of its nearest-points bound), each with its distances from the corners;
+/// and the convex quadrilaterals two of them make, with theirs.
 #[derive(Default)]
 struct Candidates {
     faces: [u32; Candidates::MAX],
+    triangles: [Triangle; Candidates::MAX],
     distances: [Vector3<f64>; Candidates::MAX],
     len: usize,
+    /// The corners' distances to convex unions of two candidates (see
+    /// [`Candidates::add`]).
+    unions: [Vector3<f64>; Candidates::UNIONS],
+    unions_len: usize,
 }
 
 impl Candidates {
     /// The corners' and the probes'.
     const MAX: usize = 3 + PROBES;
 
+    /// Convex unions kept at most: each adds to the envelope's work, and one is what a
+    /// piece lying across an edge inside a flat region of B needs.
+    const UNIONS: usize = 3;
+
     /// Tries `face` too (once; beyond [`Candidates::MAX`] the bound just stays looser).
+    ///
+    /// Where `face` and a candidate lie in one plane and make a convex quadrilateral (exact
+    /// predicates), the distance to that quadrilateral, a part of B, is convex too, and at
+    /// a corner it is the nearer of the two triangles' distances: the envelope gets that
+    /// plane as well. It closes what no single triangle can: a piece lying on two
+    /// triangles of B (coincident surfaces triangulated differently), where each
+    /// triangle's distance grows across their shared edge and the bound only shrank with
+    /// the piece's size.
     fn add<B: BoundingVolume>(
         &mut self,
         tree: &To<'_, '_, B>,
@@ -503,34 +521,52 @@ impl Candidates {
         if self.faces.iter().take(self.len).any(|&f| f == face) {
             return Ok(());
         }
-        let distances = corner_distances(tree, corners, near, face, work)?;
-        if let (Some(f), Some(d)) = (
+        let (distances, t) = corner_distances(tree, corners, near, face, work)?;
+        let earlier = self.triangles.iter().zip(&self.distances).take(self.len);
+        for (other, d) in earlier {
+            if convex_union(other, &t) {
+                if let Some(slot) = self.unions.get_mut(self.unions_len) {
+                    *slot = distances.inf(d);
+                    self.unions_len += 1;
+                }
+            }
+        }
+        if let (Some(f), Some(tri), Some(d)) = (
             self.faces.get_mut(self.len),
+            self.triangles.get_mut(self.len),
             self.distances.get_mut(self.len),
         ) {
             *f = face;
+            *tri = t;
             *d = distances;
             self.len += 1;
         }
         Ok(())
     }
 
+    /// The corners' distances to every candidate and every convex union kept.
+    fn planes(&self) -> impl Iterator<Item = &Vector3<f64>> {
+        let candidates = self.distances.iter().take(self.len);
+        candidates.chain(self.unions.iter().take(self.unions_len))
+    }
+
     /// The convexity bound of the piece and the barycentric coordinates where it peaks:
     /// see [`interpolated_envelope`].
     fn bound(&self) -> (f64, Vector3<f64>) {
-        interpolated_envelope(self.distances.get(..self.len).unwrap_or_default())
+        let mut planes = [Vector3::zeros(); Candidates::MAX + Candidates::UNIONS];
+        let mut n = 0;
+        for (slot, d) in planes.iter_mut().zip(self.planes()) {
+            *slot = *d;
+            n += 1;
+        }
+        interpolated_envelope(planes.get(..n).unwrap_or_default())
     }
 
     /// The convexity bound where it may decide the piece, else a cheaper, looser one at
-    /// most `threshold` off: the least over candidates of their largest corner distance
+    /// most `threshold` off: the least over planes of their largest corner distance
     /// (which the envelope never exceeds) when that is already within `threshold`.
     fn bound_against(&self, threshold: f64) -> f64 {
-        let loose = self
-            .distances
-            .iter()
-            .take(self.len)
-            .map(|d| d.max())
-            .fold(f64::INFINITY, f64::min);
+        let loose = self.planes().map(|d| d.max()).fold(f64::INFINITY, f64::min);
         if loose <= threshold {
             loose
         } else {

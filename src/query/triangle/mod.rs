@@ -35,6 +35,8 @@ pub use overlap::triangles_intersect;
 pub use point::{closest_point_on_triangle, Feature};
 pub use ray::{RaySpace, RayTriangleHit};
 
+pub(crate) use predicates::convex_union;
+
 use nalgebra::Vector3;
 
 /// A triangle as its three corners. Any corners are accepted, including collinear or

@@ -204,9 +204,67 @@ pub(crate) fn dominant_axis(t: &[V; 3]) -> Option<usize> {
     best
 }
 
+/// Whether two triangles together make a convex quadrilateral: they share an edge (two
+/// corners equal exactly), lie exactly in one plane, their other corners lie strictly on
+/// either side of the shared edge's line and the shared corners on either side of (or on)
+/// the line through the other two, so that the two diagonals cross. Exact on the given
+/// coordinates; `false` for degenerate triangles.
+pub(crate) fn convex_union(t: &[V; 3], u: &[V; 3]) -> bool {
+    // The corner of `t` not on the shared edge, and the edge; then `u`'s other corner.
+    let shared = |p: &V| u.contains(p);
+    let [p0, p1, p2] = t;
+    let (c, a, b) = match (shared(p0), shared(p1), shared(p2)) {
+        (false, true, true) => (p0, p1, p2),
+        (true, false, true) => (p1, p2, p0),
+        (true, true, false) => (p2, p0, p1),
+        _ => return false,
+    };
+    let Some(d) = u.iter().find(|q| *q != a && *q != b) else {
+        return false;
+    };
+    if orient3d(a, b, c, d) != 0.0 {
+        return false;
+    }
+    let Some(axis) = dominant_axis(t) else {
+        return false;
+    };
+    let [a, b, c, d] = [a, b, c, d].map(|v| project(v, axis));
+    let opposite = |x: f64, y: f64| (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0);
+    let same_side = |x: f64, y: f64| (x > 0.0 && y > 0.0) || (x < 0.0 && y < 0.0);
+    opposite(orient2d(a, b, c), orient2d(a, b, d))
+        && !same_side(orient2d(c, d, a), orient2d(c, d, b))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn two_halves_of_a_convex_quad_are_convex_and_others_are_not() {
+        let v = |x: f64, y: f64, z: f64| V::new(x, y, z);
+        let (a, b, c, d) = (v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.));
+        // A square cut along either diagonal, in any corner order.
+        assert!(convex_union(&[a, b, c], &[a, c, d]));
+        assert!(convex_union(&[c, a, b], &[d, c, a]));
+        assert!(convex_union(&[a, b, d], &[b, c, d]));
+        // A straight angle at a shared corner is still convex.
+        assert!(convex_union(&[a, b, c], &[a, c, v(-1., 0., 0.)]));
+        // Not convex: a dart, reflex at the shared corner a.
+        assert!(!convex_union(&[a, b, c], &[a, c, v(-1., -0.5, 0.)]));
+        // Overlapping: both other corners on one side of the shared edge.
+        assert!(!convex_union(&[a, b, c], &[a, c, v(0.9, 0.2, 0.)]));
+        assert!(!convex_union(&[a, b, c], &[a, c, v(3., 1., 0.)]));
+        // Folded by the least step off the plane, sharing a corner only, or degenerate.
+        assert!(!convex_union(&[a, b, c], &[a, c, v(0., 1., 1e-300)]));
+        assert!(!convex_union(
+            &[a, b, c],
+            &[a, v(-1., 0., 0.), v(-1., -1., 0.)]
+        ));
+        assert!(!convex_union(&[a, b, c], &[a, c, v(2., 2., 0.)]));
+        assert!(!convex_union(&[a, a, c], &[a, c, d]));
+        // The same triangle twice overlaps itself: no other corner.
+        assert!(!convex_union(&[a, b, c], &[a, b, c]));
+    }
 
     #[test]
     fn filter_agrees_with_robust() {
