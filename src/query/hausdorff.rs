@@ -575,8 +575,9 @@ impl Candidates {
     }
 }
 
-/// The convexity bound of a piece from its corners' distances to some triangles `t` of B
-/// (`distances[t]`, one per corner). The distance to one triangle is convex, so at the
+/// The convexity bound of a piece from its corners' distances to some convex parts `t` of
+/// B, triangles or two-triangle quadrilaterals (`distances[t]`, one per corner). The
+/// distance to a convex set is convex, so at the
 /// point of barycentric coordinates `λ` it is at most `λ · distances[t]`, and the distance
 /// to B at most the least of these planes. That lower envelope is concave and piecewise
 /// linear, so its largest value over the piece is at a vertex of its pieces: a corner,
