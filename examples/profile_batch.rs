@@ -13,7 +13,7 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use obbtree::build::{build, BuildOptions};
+use obbtree::build::build;
 use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{CollideOptions, CollideResult, PairQuery, Pose};
@@ -28,13 +28,7 @@ fn main() {
         Some(path) => TriMesh::load(std::path::Path::new(path)).expect("mesh"),
         None => common::cow(),
     };
-    let options = match std::env::var("OBBTREE_PRECISION").as_deref() {
-        Ok("f64") => BuildOptions {
-            precision: obbtree::real::Precision::F64,
-            ..BuildOptions::default()
-        },
-        _ => BuildOptions::default(),
-    };
+    let options = common::profiling_options();
     let tree = build(&mesh, &options, None).expect("build");
     let extent = (0..3)
         .map(|i| {

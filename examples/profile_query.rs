@@ -12,7 +12,7 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use obbtree::build::{build, BuildOptions};
+use obbtree::build::build;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{CollideOptions, DistanceOptions, PairQuery, Pose};
 use std::time::Instant;
@@ -22,14 +22,7 @@ fn main() {
     let kind = args.get(1).map_or("all", |s| s.as_str());
     let x: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1.0);
     let runs: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1000);
-    // `OBBTREE_PRECISION=f64` profiles f64 trees (the default is the library's, f32).
-    let options = match std::env::var("OBBTREE_PRECISION").as_deref() {
-        Ok("f64") => BuildOptions {
-            precision: obbtree::real::Precision::F64,
-            ..BuildOptions::default()
-        },
-        _ => BuildOptions::default(),
-    };
+    let options = common::profiling_options();
     let case = args.get(4).map(std::path::PathBuf::from);
     let (mesh_a, mesh_b) = match &case {
         Some(dir) => (

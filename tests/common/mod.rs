@@ -18,6 +18,18 @@ pub mod seal;
 
 use obbtree::mesh::TriMesh;
 
+/// The build options of the query profilers (`examples/profile_*`): the library's defaults
+/// (f32), in f64 where the environment says `OBBTREE_PRECISION=f64`.
+pub fn profiling_options() -> obbtree::build::BuildOptions {
+    match std::env::var("OBBTREE_PRECISION").as_deref() {
+        Ok("f64") => obbtree::build::BuildOptions {
+            precision: obbtree::real::Precision::F64,
+            ..Default::default()
+        },
+        _ => Default::default(),
+    }
+}
+
 /// A latitude/longitude sphere of `2 * slices * (stacks - 1)` triangles, like the spheres of
 /// the dissertation's §5.3.1 scene.
 pub fn uv_sphere(radius: f64, stacks: u32, slices: u32) -> TriMesh {
