@@ -433,6 +433,20 @@ struct Piece {
     triangle: u32,
 }
 
+/// The two ends of a piece two of whose corners are one point (a segment, or a point when
+/// all three are), and their nearest points on B.
+fn segment_ends(piece: &Piece) -> Option<([Vector3<f64>; 2], [Near; 2])> {
+    let [p0, p1, p2] = piece.corners;
+    let [n0, n1, n2] = piece.near;
+    if p0 == p1 {
+        Some(([p0, p2], [n0, n2]))
+    } else if p1 == p2 || p2 == p0 {
+        Some(([p0, p1], [n0, n1]))
+    } else {
+        None
+    }
+}
+
 /// Orders a heap entry by its `upper` bound alone (largest first in a `BinaryHeap`).
 macro_rules! by_upper {
     ($t:ty) => {
@@ -1207,10 +1221,7 @@ fn bound<B: BoundingVolume>(
                 let m = (a + b) / 2.0;
                 near(tree, &m, Some(seed.face), &mut scratch, &mut work).map(|n| (m, n))
             };
-            let (m01, k01) = midpoint(&p0, &p1, &n0)?;
-            let (m12, k12) = midpoint(&p1, &p2, &n1)?;
-            let (m20, k20) = midpoint(&p2, &p0, &n2)?;
-            for (m, k) in [(m01, k01), (m12, k12), (m20, k20)] {
+            let mut offer = |m: Vector3<f64>, k: Near| {
                 if k.distance > witness.near.distance {
                     witness = Witness {
                         point: m,
@@ -1218,13 +1229,36 @@ fn bound<B: BoundingVolume>(
                         triangle: piece.triangle,
                     };
                 }
-            }
-            for (corners, near) in [
-                ([p0, m01, m20], [n0, k01, k20]),
-                ([m01, p1, m12], [k01, n1, k12]),
-                ([m20, m12, p2], [k20, k12, n2]),
-                ([m01, m12, m20], [k01, k12, k20]),
-            ] {
+            };
+            let halves;
+            let quarters;
+            let children: &[([Vector3<f64>; 3], [Near; 3])] = match segment_ends(&piece) {
+                // A piece with two corners in one point is a segment, and is halved: the four
+                // triangles of a midpoint split would cover its first half three times over,
+                // so where the bounds close slowly the pieces would triple at every level.
+                Some(([a, b], [na, nb])) => {
+                    let (m, k) = midpoint(&a, &b, &na)?;
+                    offer(m, k);
+                    halves = [([a, a, m], [na, na, k]), ([m, m, b], [k, k, nb])];
+                    &halves
+                }
+                None => {
+                    let (m01, k01) = midpoint(&p0, &p1, &n0)?;
+                    let (m12, k12) = midpoint(&p1, &p2, &n1)?;
+                    let (m20, k20) = midpoint(&p2, &p0, &n2)?;
+                    for (m, k) in [(m01, k01), (m12, k12), (m20, k20)] {
+                        offer(m, k);
+                    }
+                    quarters = [
+                        ([p0, m01, m20], [n0, k01, k20]),
+                        ([m01, p1, m12], [k01, n1, k12]),
+                        ([m20, m12, p2], [k20, k12, n2]),
+                        ([m01, m12, m20], [k01, k12, k20]),
+                    ];
+                    &quarters
+                }
+            };
+            for &(corners, near) in children {
                 let threshold = enough(witness.near.distance);
                 let (child, middle) = bounded_piece(
                     tree,

@@ -518,6 +518,42 @@ fn near_coincident_surfaces_keep_the_floor() {
     }
 }
 
+/// A segment (a triangle with a repeated corner) lying on B across a joint of two of B's
+/// faces (a triangle's edge, continued by a segment) is 0 from B, and its pieces across the
+/// joint close only in proportion to their size, down to the floor. They are halved as
+/// segments: split as triangles, each piece's first half would be covered three times, and
+/// the pieces at the joint would triple at every level (a fuzz input of such segments took
+/// seconds: `fuzz/regressions/differential/hausdorff-segment-joint-*`).
+#[test]
+fn a_segment_across_a_joint_is_split_as_a_segment() {
+    let segment =
+        TriMesh::new(vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]], vec![[0, 0, 1]]).expect("a segment");
+    let joint = TriMesh::new(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+        ],
+        vec![[0, 1, 2], [1, 1, 3]],
+    )
+    .expect("a triangle and a segment");
+    let built = |mesh: &TriMesh| build(mesh, &BuildOptions::default(), None).expect("builds");
+    let (a, b) = (built(&segment), built(&joint));
+    let id = Pose::identity();
+    let floor_gap = 2.0 * 2.0 / f64::from(1u32 << 16);
+    for rel_err in [0.0, 1e-6] {
+        let options = HausdorffOptions {
+            rel_err,
+            ..HausdorffOptions::default()
+        };
+        let h = hausdorff(&a, &id, &b, &id, &options).expect("answers");
+        assert_eq!(h.distance, 0.0, "{h:?}");
+        assert!(h.upper_bound <= floor_gap, "{h:?}");
+        assert!(h.work.nodes_visited <= 200, "{:?}", h.work);
+    }
+}
+
 /// A warm start from the answer at a nearby pose gives the same answer (to rounding) with
 /// less work, in both directions of a symmetric query; a warm start of the other direction
 /// only is ignored for the one it does not name.
