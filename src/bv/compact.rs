@@ -257,6 +257,45 @@ mod tests {
         }
     }
 
+    /// A compact box holds what it encloses and measures as the box it decodes to: centred
+    /// in its world box, its ball and diameter reaching every enclosed point.
+    #[test]
+    fn compact_boxes_hold_and_measure_what_they_enclose() {
+        let positions = [
+            [0.1, -0.4, 2.0],
+            [1.3, 0.2, 1.1],
+            [-0.7, 0.9, 0.4],
+            [0.5, 0.5, -1.2],
+        ];
+        let faces = [[0, 1, 2], [0, 2, 3], [1, 2, 3]];
+        let frame = Rotation3::from_euler_angles(0.3, -1.2, 2.9).into_inner();
+        let compact = CompactObb::enclose(&frame, &positions, &faces);
+        let world = compact.world_aabb(&Pose::identity());
+        let (ball, radius) = compact.enclosing_ball();
+        let distance = |p: [f64; 3], q: [f64; 3]| crate::arr3::norm2(crate::arr3::sub(p, q)).sqrt();
+        for p in positions {
+            assert!(compact.contains(p, 0.0), "{p:?} outside {compact:?}");
+            for ((lo, hi), x) in world.min.iter().zip(world.max).zip(p) {
+                assert!(*lo <= x && x <= hi, "{p:?} outside {world:?}");
+            }
+            assert!(distance(ball, p) <= radius);
+            for q in positions {
+                assert!(distance(p, q) <= compact.diameter());
+            }
+        }
+        for ((c, lo), hi) in compact.center().iter().zip(world.min).zip(world.max) {
+            assert!(
+                (c - (lo + hi) / 2.0).abs() < 1e-6,
+                "{c} not centred in {world:?}"
+            );
+        }
+        let decoded = compact.decode();
+        assert_eq!(compact.volume(), decoded.volume());
+        assert_eq!(compact.surface_area(), decoded.surface_area());
+        assert_eq!(compact.thickness(), decoded.thickness());
+        assert!(0.0 < compact.thickness() && compact.thickness() <= compact.diameter());
+    }
+
     #[test]
     fn frames_survive_quantisation() {
         let frames = [

@@ -568,6 +568,96 @@ mod tests {
     use super::*;
     use crate::generate::Rng;
 
+    /// The header tags are the format's (formats/obbt.md) and the names the CLI's: fixed
+    /// values, each read back to its kind, anything else refused.
+    #[test]
+    fn tags_and_names_are_fixed_and_read_back() {
+        let bvs = [
+            (BvKind::Obb, 1, "obb"),
+            (BvKind::Aabb, 2, "aabb"),
+            (BvKind::Sphere, 3, "sphere"),
+        ];
+        for (kind, tag, name) in bvs {
+            assert_eq!((kind.tag(), kind.name()), (tag, name));
+            assert_eq!(BvKind::from_tag(tag), Some(kind));
+            assert_eq!(BvKind::from_name(name), Some(kind));
+        }
+        let layouts = [
+            (Layout::Fast, 0, "fast", 1),
+            (Layout::Compact, 1, "compact", 4),
+        ];
+        for (layout, tag, name, leaf_size) in layouts {
+            assert_eq!((layout.tag(), layout.name()), (tag, name));
+            assert_eq!(Layout::from_tag(tag), Some(layout));
+            assert_eq!(Layout::from_name(name), Some(layout));
+            assert_eq!(layout.default_leaf_size(), leaf_size);
+        }
+        for tag in [0, 4, 255] {
+            assert_eq!(BvKind::from_tag(tag), None);
+        }
+        assert_eq!(Layout::from_tag(2), None);
+        for name in ["", "OBB", "ball", "xyzzy"] {
+            assert_eq!(BvKind::from_name(name), None);
+            assert_eq!(Layout::from_name(name), None);
+        }
+    }
+
+    /// A node's record fills exactly its stride, as the builder writes nodes back to back:
+    /// the volume's bytes, the packed reference, zero padding, and nothing past the stride.
+    #[test]
+    fn node_records_fill_their_stride_and_no_more() {
+        fn check<B: BoundingVolume>() {
+            let positions = [[0.0, 0.0, 0.0], [1.0, 0.5, 0.0], [0.25, 2.0, 3.0]];
+            let bv = B::enclose(&Matrix3::identity(), &positions, &[[0, 1, 2]]);
+            let mut volume = vec![0u8; std::mem::size_of::<B>()];
+            bv.write_le(&mut volume);
+            let mut out = vec![0xAAu8; Node::<B>::SIZE + 16];
+            Node::new(bv, 0x1234_5678).write_le(&mut out);
+            let (record, past) = out.split_at(Node::<B>::SIZE);
+            let (bytes, rest) = record.split_at(volume.len());
+            let (packed, pad) = rest.split_at(4);
+            assert_eq!(bytes, volume);
+            assert_eq!(packed, 0x1234_5678u32.to_le_bytes());
+            assert!(pad.iter().all(|&b| b == 0), "padding {pad:?}");
+            assert!(
+                past.iter().all(|&b| b == 0xAA),
+                "written past the record: {past:?}"
+            );
+        }
+        check::<Obb<f32>>();
+        check::<Obb<f64>>();
+        check::<Aabb<f64>>();
+        check::<Sphere<f64>>();
+        check::<CompactObb>();
+    }
+
+    /// Only f32 oriented boxes have a compact layout, and messages name the layout only
+    /// when it is not the default.
+    #[test]
+    fn node_types_exist_only_as_stored() {
+        for bv in BvKind::ALL {
+            for precision in [Precision::F32, Precision::F64] {
+                let compact = NodeType::new(bv, precision, Layout::Compact);
+                assert_eq!(
+                    compact.is_ok(),
+                    (bv, precision) == (BvKind::Obb, Precision::F32)
+                );
+                let fast = NodeType::new(bv, precision, Layout::Fast).unwrap();
+                assert_eq!(fast, NodeType::plain(bv, precision));
+                assert_eq!(
+                    (fast.bv(), fast.precision(), fast.layout()),
+                    (bv, precision, Layout::Fast)
+                );
+            }
+        }
+        let compact = NodeType::new(BvKind::Obb, Precision::F32, Layout::Compact).unwrap();
+        assert_eq!(compact.to_string(), "obb f32 compact");
+        assert_eq!(
+            NodeType::plain(BvKind::Sphere, Precision::F64).to_string(),
+            "sphere f64"
+        );
+    }
+
     /// The broad phase trusts the world box to hold the whole posed box: every corner,
     /// mapped by the pose in f64, lies inside it, under turned frames and far translations
     /// whose rounding is many times the box's own ulps.

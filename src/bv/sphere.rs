@@ -203,6 +203,29 @@ mod tests {
     use super::*;
     use crate::generate::Rng;
 
+    /// `verify` refuses a stored sphere with any non-finite number, whichever it is, and a
+    /// negative radius; a point sphere is well formed.
+    #[test]
+    fn validate_names_each_defect() {
+        let sphere = |center: [f64; 3], radius: f64| Sphere { center, radius };
+        assert_eq!(sphere([1.0, -2.0, 3.0], 0.5).validate(), Ok(()));
+        assert_eq!(sphere([1.0, -2.0, 3.0], 0.0).validate(), Ok(()));
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            assert_eq!(
+                sphere([1.0, bad, 3.0], 0.5).validate(),
+                Err(BvDefect::NotFinite)
+            );
+            assert_eq!(
+                sphere([1.0, -2.0, 3.0], bad).validate(),
+                Err(BvDefect::NotFinite)
+            );
+        }
+        assert_eq!(
+            sphere([1.0, -2.0, 3.0], -0.5).validate(),
+            Err(BvDefect::NegativeExtent)
+        );
+    }
+
     /// The measures a descent rule and the statistics read, by their formulas.
     #[test]
     fn measures_are_the_spheres() {

@@ -393,3 +393,60 @@ impl Summary {
         }})
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Effect;
+
+    fn one_pair(answer: Answer) -> FrameReport {
+        FrameReport {
+            frame: 7,
+            pairs: vec![PairReport { a: 0, b: 1, answer }],
+            events: Vec::new(),
+        }
+    }
+
+    fn distance(distance: f64) -> Answer {
+        Answer::Distance {
+            distance,
+            tri_a: 3,
+            tri_b: 4,
+        }
+    }
+
+    /// The fast path's distance may exceed the reference's by the rule's `rel_err` and
+    /// rounding (1e-9 of the distance plus 1e-9), and fall below it by rounding only.
+    #[test]
+    fn distances_agree_within_the_rules_error_and_rounding() {
+        let y = 10.0;
+        let reference = one_pair(distance(y));
+        let agrees = |x: f64, rel_err: f64| {
+            let effect = |_: ObjectId, _: ObjectId| Effect::Distance {
+                rel_err,
+                max_distance: None,
+            };
+            one_pair(distance(x))
+                .disagreement(&reference, effect)
+                .is_none()
+        };
+        let rounding = 1e-9 * (1.0 + y);
+        for rel_err in [0.0, 0.01] {
+            let top = y * (1.0 + rel_err);
+            assert!(agrees(top + 0.9 * rounding, rel_err));
+            assert!(!agrees(top + 1.1 * rounding, rel_err));
+            assert!(agrees(y - 0.9 * rounding, rel_err));
+            assert!(!agrees(y - 1.1 * rounding, rel_err));
+        }
+        // Another pair, or another kind of answer, disagrees whatever the distances.
+        let effect = |_: ObjectId, _: ObjectId| Effect::Span;
+        let mut other = one_pair(distance(y));
+        if let Some(p) = other.pairs.first_mut() {
+            p.b = 2;
+        }
+        assert!(other.disagreement(&reference, effect).is_some());
+        assert!(one_pair(Answer::Span(y))
+            .disagreement(&reference, effect)
+            .is_some());
+    }
+}

@@ -16,6 +16,7 @@ use std::path::Path;
 struct MutantsConfig {
     examine_globs: Vec<String>,
     profile: String,
+    additional_cargo_args: Vec<String>,
     additional_cargo_test_args: Vec<String>,
     exclude_re: Vec<String>,
 }
@@ -60,10 +61,10 @@ fn mutants_config_parses_and_names_what_exists() {
         .lines()
         .filter_map(|l| l.strip_prefix("mod ")?.strip_suffix(';'))
         .collect();
-    let args = &config.additional_cargo_test_args;
-    let dash = args.iter().position(|a| a == "--").unwrap();
-    assert_eq!(&args[..dash], ["--lib", "--test", "it"]);
-    for filter in &args[dash + 1..] {
+    assert_eq!(config.additional_cargo_args, ["--lib", "--test", "it"]);
+    let (dash, filters) = config.additional_cargo_test_args.split_first().unwrap();
+    assert_eq!(dash, "--");
+    for filter in filters {
         let module = filter.strip_suffix("::").unwrap();
         assert!(
             module == "tests" || modules.contains(module),
