@@ -321,6 +321,51 @@ mod tests {
         }
     }
 
+    /// Each term of the filter's error bound counts: a point straight above a corner of a
+    /// nearly vertical triangle (coordinates in the hundreds) leaves only the z term, and
+    /// the z component of the normal cancels nearly to nothing, its sign decided by the
+    /// products' rounding. The filter must hand every such case it cannot certify to the
+    /// exact routine.
+    #[test]
+    fn plane_side_is_exact_where_the_normal_cancels() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut decided_by_rounding = 0;
+        let coordinate = |u: f64| 400.0 * u - 200.0;
+        for _ in 0..20_000 {
+            let t0 = V::new(coordinate(unit()), coordinate(unit()), coordinate(unit()));
+            let along = V::new(coordinate(unit()), coordinate(unit()), coordinate(unit()));
+            // t2 on the line through t0 and t1 in x and y (up to rounding), anywhere in z.
+            let s = 2.0 * unit() - 0.5;
+            let t = [
+                t0,
+                t0 + along,
+                V::new(t0.x + s * along.x, t0.y + s * along.y, coordinate(unit())),
+            ];
+            let x = V::new(t0.x, t0.y, t0.z + coordinate(unit()));
+            let exact = -orient3d_adaptive(&t[0], &t[1], &t[2], &x);
+            let side = PlaneSide::new(&t).side(&t, &x);
+            assert_eq!(
+                side.partial_cmp(&0.0),
+                exact.partial_cmp(&0.0),
+                "{t:?} {x:?}"
+            );
+            let d = x - t[0];
+            let n = t[1] - t[0];
+            let m = t[2] - t[0];
+            if (d.z * (n.x * m.y - n.y * m.x)).partial_cmp(&0.0) != exact.partial_cmp(&0.0) {
+                decided_by_rounding += 1;
+            }
+        }
+        // The cases exist: the rounded determinant has the wrong sign in many of them.
+        assert!(decided_by_rounding > 100, "{decided_by_rounding}");
+    }
+
     #[test]
     fn orient3d_sign_convention() {
         let o = V::zeros();
