@@ -8,13 +8,14 @@
 //! between, and `> 0.5` is the robust inside test.
 
 use super::closest::{closest_points, ClosestOptions};
-use super::engine::{corrupt, triangle};
+use super::engine::corrupt;
+use super::index::{Slot, SurfaceIndex, WIDTH};
 use super::triangle::Triangle;
 use super::{check_points, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
-use crate::tree::{NodeDefect, NodeKind, TreeView};
+use crate::tree::{NodeDefect, TreeView};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::cmp::Ordering::Greater;
@@ -153,16 +154,16 @@ pub fn winding_numbers(
     impl TreeVisitor for Visit<'_> {
         type Output = Result<Vec<WindingResult>, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
-            // Made at the file's first winding query and kept with it, as the surface index.
-            let clusters = self.model.derived(|| Clusters::of(&tree))?;
-            let (moments, reach) = (&clusters.moments, &clusters.reach);
+            // Both made at the file's first such query and kept with it.
+            let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
+            let clusters = self.model.derived(|| Clusters::of(&index))?;
             let rule = match self.accuracy {
                 WindingAccuracy::Exact => Rule::Exact,
                 // Bound per unit area: a cluster of area A may err by A times this.
-                WindingAccuracy::Bounded { tolerance } => match moments.first().map(|m| m.area) {
-                    Some(total) if total > 0.0 => Rule::Rate(tolerance / total),
-                    _ => Rule::Exact,
-                },
+                WindingAccuracy::Bounded { tolerance } if clusters.area > 0.0 => {
+                    Rule::Rate(tolerance / clusters.area)
+                }
+                WindingAccuracy::Bounded { .. } => Rule::Exact,
                 WindingAccuracy::Beta { beta } => Rule::Beta(beta),
             };
             let to_model = Pose::relative(self.pose, &Pose::identity());
@@ -170,7 +171,7 @@ pub fn winding_numbers(
                 .par_iter()
                 .map_init(Vec::new, |stack, p| {
                     let local = to_model.apply(&Vector3::from(*p));
-                    descend(&tree, reach, moments, &local, rule, stack)
+                    descend(&index, &clusters, &local, rule, stack)
                 })
                 .collect()
         }
@@ -217,7 +218,8 @@ pub fn signed_distances(
         .collect())
 }
 
-/// What a cluster of triangles (a node's) looks like from afar (model frame): its area, its
+/// What a cluster of triangles (a child of a surface index node) looks like from afar
+/// (model frame): its area, its
 /// area-weighted normal `N = Σ A n`, its area-weighted centroid `c`, the moments
 /// `spread = Σ n ∫ (x − c)ᵀ dA` and `bend[i] = Σ nᵢ ∫ (x − c)(x − c)ᵀ dA` over its
 /// triangles (unit normals `n`), and the radius about `c` within which all its corners lie.
@@ -261,92 +263,113 @@ impl Moment {
     }
 }
 
-/// What a descent reads of every node it reaches: the moment's centroid, radius and area,
-/// apart from the rest, which it reads only for the clusters it sums by moments (a tenth
-/// of the bytes, for the nodes a point opens).
-#[derive(Clone, Copy, Debug)]
-struct Reach {
-    centroid: Vector3<f64>,
-    radius: f64,
+/// The surface index's children as clusters of triangles: for each node, what a descent
+/// reads of every child it meets (centroid, radius, area), the node's children side by
+/// side; and each child's [`Expansion`], read only for the clusters summed by moments.
+struct Clusters {
+    reach: Vec<Reach>,
+    /// Child `lane` of node `n` at `n * WIDTH + lane`.
+    expansions: Vec<Expansion>,
+    /// The whole model's area.
     area: f64,
 }
 
-/// Every node's moments, and the part of them a descent reads for every cluster it meets.
-struct Clusters {
-    moments: Vec<Moment>,
-    reach: Vec<Reach>,
+/// The centroids (by coordinate), radii and areas of a node's children.
+#[derive(Clone, Copy, Debug, Default)]
+struct Reach {
+    centroid: [[f64; WIDTH]; 3],
+    radius: [f64; WIDTH],
+    area: [f64; WIDTH],
 }
 
 impl Clusters {
-    fn of<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Clusters, QueryError> {
-        let moments = moments(tree)?;
+    fn of(index: &SurfaceIndex) -> Result<Clusters, QueryError> {
+        let moments = slot_moments(index)?;
         let reach = moments
-            .iter()
-            .map(|m| Reach {
-                centroid: m.centroid,
-                radius: m.radius,
-                area: m.area,
+            .chunks_exact(WIDTH)
+            .map(|lanes| {
+                let m: [Moment; WIDTH] = lanes.try_into().unwrap_or([Moment::default(); WIDTH]);
+                Reach {
+                    centroid: [
+                        m.map(|m| m.centroid.x),
+                        m.map(|m| m.centroid.y),
+                        m.map(|m| m.centroid.z),
+                    ],
+                    radius: m.map(|m| m.radius),
+                    area: m.map(|m| m.area),
+                }
             })
             .collect();
-        Ok(Clusters { moments, reach })
+        Ok(Clusters {
+            reach,
+            expansions: moments.iter().map(Expansion::of).collect(),
+            area: moments.iter().take(WIDTH).map(|m| m.area).sum(),
+        })
     }
 }
 
-/// Every node's moment, children before parents (children follow their parent in the
-/// node array, checked by `node_kind`).
-fn moments<B: BoundingVolume>(tree: &TreeView<'_, B>) -> Result<Vec<Moment>, QueryError> {
-    let mut out = vec![Moment::default(); tree.nodes().len()];
-    for node in (0..tree.nodes().len() as u32).rev() {
-        let m = match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
-            NodeKind::Faces(faces) => {
-                let triangles = faces
-                    .map(|face| triangle(tree, face, None, Side::A))
-                    .collect::<Result<Vec<_>, _>>()?;
-                of_triangles(&triangles)
-            }
-            NodeKind::Children(range) => {
-                let kids = out
-                    .get(range.start as usize..range.end as usize)
-                    .ok_or_else(|| corrupt(Side::A, NodeDefect::BadChildren))?;
-                let area = kids.iter().map(|k| k.area).sum::<f64>();
-                let normal = kids.iter().map(|k| k.normal).sum();
-                let weighted = kids.iter().map(|k| k.centroid * k.area).sum();
-                let centroid = centre(weighted, area, kids.iter().map(|k| k.centroid));
-                // Each child's spread, moved from its centroid to the parent's.
-                let spread = kids
-                    .iter()
-                    .map(|k| k.spread + k.normal * (k.centroid - centroid).transpose())
-                    .sum();
-                // And each child's bend: with δ = c_child − c,
-                // bend'ᵢ = bendᵢ + sᵢ δᵀ + δ sᵢᵀ + Nᵢ δ δᵀ (sᵢ row i of the child's spread).
-                let mut bend = [Matrix3::zeros(); 3];
-                for k in kids {
-                    let delta = k.centroid - centroid;
-                    let rows = bend
-                        .iter_mut()
-                        .zip(&k.bend)
-                        .zip(k.normal.iter())
-                        .enumerate();
-                    for (i, ((b, kb), ni)) in rows {
-                        let s = k.spread.row(i).transpose();
-                        *b += kb
-                            + s * delta.transpose()
-                            + delta * s.transpose()
-                            + delta * delta.transpose() * *ni;
-                    }
+/// The moment of every child slot of `index`, child `lane` of node `n` at `n * WIDTH +
+/// lane` (an empty slot's is zero): a node's children are after it, so in reverse order a
+/// child node's slots are done before the slot holding it merges them.
+fn slot_moments(index: &SurfaceIndex) -> Result<Vec<Moment>, QueryError> {
+    let missing = || corrupt(Side::A, NodeDefect::Missing);
+    let mut out = vec![Moment::default(); index.node_count() * WIDTH];
+    for node in (0..index.node_count()).rev() {
+        let slots = index.node(node as u32).ok_or_else(missing)?.slots();
+        for (lane, slot) in slots {
+            let m = match slot {
+                Slot::Node(child) => {
+                    let kids = index.node(child).ok_or_else(missing)?.slots();
+                    let kids = kids
+                        .map(|(lane, _)| out.get(child as usize * WIDTH + lane).copied())
+                        .collect::<Option<Vec<Moment>>>()
+                        .ok_or_else(missing)?;
+                    merge(&kids)
                 }
-                let radius = kids
-                    .iter()
-                    .map(|k| (k.centroid - centroid).norm() + k.radius)
-                    .fold(0.0, f64::max);
-                Moment::new(area, normal, centroid, spread, bend, radius)
-            }
-        };
-        if let Some(slot) = out.get_mut(node as usize) {
-            *slot = m;
+                Slot::Triangles(range) => {
+                    let triangles = range
+                        .map(|i| index.triangle(i).map(|(t, _)| *t).ok_or_else(missing))
+                        .collect::<Result<Vec<Triangle>, _>>()?;
+                    of_triangles(&triangles)
+                }
+            };
+            *out.get_mut(node * WIDTH + lane).ok_or_else(missing)? = m;
         }
     }
     Ok(out)
+}
+
+/// The moment of the union of clusters.
+fn merge(kids: &[Moment]) -> Moment {
+    let area = kids.iter().map(|k| k.area).sum::<f64>();
+    let normal = kids.iter().map(|k| k.normal).sum();
+    let weighted = kids.iter().map(|k| k.centroid * k.area).sum();
+    let centroid = centre(weighted, area, kids.iter().map(|k| k.centroid));
+    // Each child's spread, moved from its centroid to the parent's.
+    let spread = kids
+        .iter()
+        .map(|k| k.spread + k.normal * (k.centroid - centroid).transpose())
+        .sum();
+    // And each child's bend: with δ = c_child − c,
+    // bend'ᵢ = bendᵢ + sᵢ δᵀ + δ sᵢᵀ + Nᵢ δ δᵀ (sᵢ row i of the child's spread).
+    let mut bend = [Matrix3::zeros(); 3];
+    for k in kids {
+        let delta = k.centroid - centroid;
+        let rows = bend
+            .iter_mut()
+            .zip(&k.bend)
+            .zip(k.normal.iter())
+            .enumerate();
+        for (i, ((b, kb), ni)) in rows {
+            let s = k.spread.row(i).transpose();
+            *b += kb + s * delta.transpose() + delta * s.transpose() + delta * delta.transpose() * *ni;
+        }
+    }
+    let radius = kids
+        .iter()
+        .map(|k| (k.centroid - centroid).norm() + k.radius)
+        .fold(0.0, f64::max);
+    Moment::new(area, normal, centroid, spread, bend, radius)
 }
 
 /// The moment of a cluster of triangles, from the triangles themselves.
@@ -425,72 +448,152 @@ enum Rule {
     Beta(f64),
 }
 
-/// One point's winding number: clusters the rule accepts are summed by moments, leaves
-/// exactly, the rest opened.
-fn descend<B: BoundingVolume>(
-    tree: &TreeView<'_, B>,
-    reach: &[Reach],
-    moments: &[Moment],
+/// A cluster's moments as its far-field expansion reads them. Seen from a point at `u`
+/// from the centroid (`u = c − p`, `d = |u|`), the cluster's solid angle is to second order
+/// `(N·u + tr spread) / d³ − (3 uᵀ spread u + v·u) / d⁵ + C(u) / d⁷`: the kernel
+/// `g = ∇φ`, `φ(x) = −1/|x − p|`, expanded about the centroid (`∂ᵢφ = uᵢ/d³`,
+/// `∂ᵢⱼφ = δᵢⱼ/d³ − 3uᵢuⱼ/d⁵`, `∂ᵢⱼₖφ = −3(δᵢⱼuₖ + δᵢₖuⱼ + δⱼₖuᵢ)/d⁵ + 15uᵢuⱼuₖ/d⁷`)
+/// against `N`, `spread` and `bend / 2`. Kept are the coefficients of those forms, the
+/// constants folded in: 23 numbers where the moment has 40.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Expansion {
+    /// `N`.
+    normal: [f64; 3],
+    /// `tr spread`.
+    trace: f64,
+    /// `3 uᵀ spread u`: the coefficients of x², y², z², xy, yz, zx.
+    square: [f64; 6],
+    /// `v = 3/2 (2 Σᵢ row i of bendᵢ + (tr bendᵢ)ᵢ)`.
+    linear: [f64; 3],
+    /// `C(u) = 15/2 Σᵢⱼₖ uᵢ bendᵢ[j][k] uⱼ uₖ`: the coefficients of x³, y³, z³, x²y, x²z,
+    /// xy², y²z, xz², yz², xyz.
+    cubic: [f64; 10],
+}
+
+impl Expansion {
+    fn of(m: &Moment) -> Expansion {
+        let s = &m.spread;
+        let linear = (m.bend_rows * 2.0 + m.bend_traces) * 1.5;
+        let mut cubic = [0.0; 10];
+        for (i, b) in m.bend.iter().enumerate() {
+            for (j, row) in b.row_iter().enumerate() {
+                for (k, value) in row.iter().enumerate() {
+                    // The monomial by how often x, y and z occur in (i, j, k).
+                    let count = |axis| [i, j, k].iter().filter(|&&a| a == axis).count();
+                    let slot = match (count(0), count(1), count(2)) {
+                        (3, 0, 0) => 0,
+                        (0, 3, 0) => 1,
+                        (0, 0, 3) => 2,
+                        (2, 1, 0) => 3,
+                        (2, 0, 1) => 4,
+                        (1, 2, 0) => 5,
+                        (0, 2, 1) => 6,
+                        (1, 0, 2) => 7,
+                        (0, 1, 2) => 8,
+                        _ => 9,
+                    };
+                    if let Some(c) = cubic.get_mut(slot) {
+                        *c += 7.5 * value;
+                    }
+                }
+            }
+        }
+        Expansion {
+            normal: m.normal.into(),
+            trace: s.trace(),
+            square: [
+                3.0 * s.m11,
+                3.0 * s.m22,
+                3.0 * s.m33,
+                3.0 * (s.m12 + s.m21),
+                3.0 * (s.m23 + s.m32),
+                3.0 * (s.m13 + s.m31),
+            ],
+            linear: linear.into(),
+            cubic,
+        }
+    }
+
+    /// The cluster's solid angle seen from `u` away from its centroid, `d = |u|`.
+    #[inline(always)]
+    fn solid_angle(&self, [x, y, z]: [f64; 3], d: f64) -> f64 {
+        let [nx, ny, nz] = self.normal;
+        let [xx, yy, zz, xy, yz, zx] = self.square;
+        let [vx, vy, vz] = self.linear;
+        let [xxx, yyy, zzz, xxy, xxz, xyy, yyz, xzz, yzz, xyz] = self.cubic;
+        let first = nx * x + ny * y + nz * z + self.trace;
+        let second =
+            x * (xx * x + xy * y + vx) + y * (yy * y + yz * z + vy) + z * (zz * z + zx * x + vz);
+        let third = x * x * (xxx * x + xxy * y + xxz * z)
+            + y * y * (yyy * y + xyy * x + yyz * z)
+            + z * z * (zzz * z + xzz * x + yzz * y)
+            + xyz * x * y * z;
+        let inverse2 = 1.0 / (d * d);
+        inverse2 / d * (first - inverse2 * (second - inverse2 * third))
+    }
+}
+
+/// One point's winding number: clusters the rule accepts are summed by their expansions,
+/// leaves' triangles exactly, the rest opened; a node's children are met together.
+fn descend(
+    index: &SurfaceIndex,
+    clusters: &Clusters,
     p: &Vector3<f64>,
     rule: Rule,
     stack: &mut Vec<u32>,
 ) -> Result<WindingResult, QueryError> {
+    let missing = || corrupt(Side::A, NodeDefect::Missing);
     let (mut sum, mut bound, mut work) = (0.0, 0.0, Work::default());
     stack.clear();
     stack.push(0);
     while let Some(node) = stack.pop() {
-        work.nodes_visited += 1;
-        let missing = || corrupt(Side::A, NodeDefect::Missing);
-        let near = reach.get(node as usize).ok_or_else(missing)?;
-        let offset = near.centroid - p;
-        let distance = offset.norm();
-        if distance > near.radius {
-            let (gap, r) = (distance - near.radius, near.radius);
-            // The bound on what summing by moments errs by.
-            let error = || near.area * r * r * r / (PI * gap * gap * gap * gap * gap);
-            // The bound of a cluster summed by moments, computed once and only when needed.
-            let accepted = match rule {
-                Rule::Exact => None,
-                Rule::Rate(rate) => Some(error()).filter(|e| *e <= rate * near.area),
-                Rule::Beta(beta) => (distance > beta * r).then(error),
-            };
-            if let Some(error) = accepted {
-                let m = moments.get(node as usize).ok_or_else(missing)?;
-                // The kernel g = ∇φ, φ(x) = −1/|x − p|, to second order about the
-                // centroid, u = c − p: ∂ᵢφ = uᵢ/d³, ∂ᵢⱼφ = δᵢⱼ/d³ − 3uᵢuⱼ/d⁵,
-                // ∂ᵢⱼₖφ = −3(δᵢⱼuₖ + δᵢₖuⱼ + δⱼₖuᵢ)/d⁵ + 15uᵢuⱼuₖ/d⁷, against N, spread
-                // and bend/2.
-                let u = offset;
-                let d2 = distance * distance;
-                let d3 = d2 * distance;
-                let (d5, d7) = (d3 * d2, d3 * d2 * d2);
-                let quadratic: f64 = m
-                    .bend
-                    .iter()
-                    .zip(u.iter())
-                    .map(|(b, ui)| ui * u.dot(&(b * u)))
-                    .sum();
-                sum += m.normal.dot(&u) / d3 + m.spread.trace() / d3
-                    - 3.0 * u.dot(&(m.spread * u)) / d5
-                    + 0.5
-                        * (-3.0 * (2.0 * m.bend_rows.dot(&u) + m.bend_traces.dot(&u)) / d5
-                            + 15.0 * quadratic / d7);
-                bound += error;
-                work.bv_disjoint += 1;
+        let (Some(children), Some(reach)) = (index.node(node), clusters.reach.get(node as usize))
+        else {
+            return Err(missing());
+        };
+        // The children's offsets and distances, all at once.
+        let [cx, cy, cz] = &reach.centroid;
+        let ux: [f64; WIDTH] = std::array::from_fn(|lane| cx.get(lane).map_or(0.0, |c| c - p.x));
+        let uy: [f64; WIDTH] = std::array::from_fn(|lane| cy.get(lane).map_or(0.0, |c| c - p.y));
+        let uz: [f64; WIDTH] = std::array::from_fn(|lane| cz.get(lane).map_or(0.0, |c| c - p.z));
+        let lanes = ux.iter().zip(&uy).zip(&uz).zip(reach.radius.iter().zip(&reach.area));
+        let mut slots = children.slots().peekable();
+        for (lane, (((&x, &y), &z), (&r, &area))) in lanes.enumerate() {
+            let Some((_, slot)) = slots.next_if(|(at, _)| *at == lane) else {
                 continue;
-            }
-        }
-        match tree.node_kind(node).map_err(|d| corrupt(Side::A, d))? {
-            NodeKind::Faces(faces) => {
-                for face in faces {
-                    let t = triangle(tree, face, None, Side::A)?;
-                    sum += solid_angle(&(t[0] - p), &(t[1] - p), &(t[2] - p));
-                    work.tri_separated += 1;
+            };
+            work.nodes_visited += 1;
+            let distance = (x * x + y * y + z * z).sqrt();
+            if distance > r {
+                let gap = distance - r;
+                // The bound on what summing by moments errs by.
+                let error = || area * r * r * r / (PI * gap * gap * gap * gap * gap);
+                let accepted = match rule {
+                    Rule::Exact => None,
+                    Rule::Rate(rate) => Some(error()).filter(|e| *e <= rate * area),
+                    Rule::Beta(beta) => (distance > beta * r).then(error),
+                };
+                if let Some(error) = accepted {
+                    let at = node as usize * WIDTH + lane;
+                    let expansion = clusters.expansions.get(at).ok_or_else(missing)?;
+                    sum += expansion.solid_angle([x, y, z], distance);
+                    bound += error;
+                    work.bv_disjoint += 1;
+                    continue;
                 }
             }
-            NodeKind::Children(range) => {
-                work.bv_overlap += 1;
-                stack.extend(range);
+            match slot {
+                Slot::Node(child) => {
+                    work.bv_overlap += 1;
+                    stack.push(child);
+                }
+                Slot::Triangles(range) => {
+                    for i in range {
+                        let (t, _) = index.triangle(i).ok_or_else(missing)?;
+                        sum += solid_angle(&(t[0] - p), &(t[1] - p), &(t[2] - p));
+                        work.tri_separated += 1;
+                    }
+                }
             }
         }
     }
@@ -506,44 +609,97 @@ mod tests {
     use super::*;
     use crate::build::{build, BuildOptions};
 
+    /// The index of a small sphere's file.
+    fn sphere_index() -> SurfaceIndex {
+        let mesh = crate::generate::lat_long_sphere(1.0, 7, 9).expect("a sphere");
+        let file = build(&mesh, &BuildOptions::default(), None).expect("builds");
+        struct Index;
+        impl TreeVisitor for Index {
+            type Output = SurfaceIndex;
+            fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> SurfaceIndex {
+                SurfaceIndex::build(&tree).expect("an index")
+            }
+        }
+        file.visit(Index).expect("a view")
+    }
+
     /// Merging children's moments gives what the subtree's triangles give directly.
     #[test]
     fn merged_moments_equal_the_moments_of_the_triangles() {
-        let mesh = crate::generate::lat_long_sphere(1.0, 7, 9).expect("a sphere");
-        let file = build(&mesh, &BuildOptions::default(), None).expect("builds");
-        struct Check;
-        impl TreeVisitor for Check {
-            type Output = ();
-            fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) {
-                let merged = moments(&tree).expect("moments");
-                // Each node's faces: a leaf's own, else its children's.
-                let mut faces: Vec<Vec<u32>> = vec![Vec::new(); merged.len()];
-                for node in (0..merged.len() as u32).rev() {
-                    faces[node as usize] = match tree.node_kind(node).expect("a node") {
-                        NodeKind::Faces(range) => range.collect(),
-                        NodeKind::Children(range) => {
-                            range.flat_map(|c| faces[c as usize].clone()).collect()
-                        }
-                    };
-                }
-                for (node, m) in merged.iter().enumerate() {
-                    let ts: Vec<Triangle> = faces[node]
-                        .iter()
-                        .map(|&f| triangle(&tree, f, None, Side::A).expect("a triangle"))
-                        .collect();
-                    let direct = of_triangles(&ts);
-                    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
-                    assert!(close(m.area, direct.area));
-                    assert!((m.centroid - direct.centroid).norm() < 1e-12);
-                    assert!((m.normal - direct.normal).norm() < 1e-12);
-                    assert!((m.spread - direct.spread).norm() < 1e-12, "node {node}");
-                    for i in 0..3 {
-                        assert!((m.bend[i] - direct.bend[i]).norm() < 1e-12, "node {node}");
-                    }
-                    assert!(m.radius >= direct.radius - 1e-12);
-                }
+        let index = sphere_index();
+        let merged = slot_moments(&index).expect("moments");
+        // The triangles under a slot.
+        fn under(index: &SurfaceIndex, slot: &Slot) -> Vec<Triangle> {
+            match slot {
+                Slot::Triangles(range) => range
+                    .clone()
+                    .map(|i| *index.triangle(i).expect("a triangle").0)
+                    .collect(),
+                Slot::Node(n) => index
+                    .node(*n)
+                    .expect("a node")
+                    .slots()
+                    .flat_map(|(_, s)| under(index, &s))
+                    .collect(),
             }
         }
-        file.visit(Check).expect("a view");
+        let mut slots = 0;
+        for node in 0..index.node_count() {
+            for (lane, slot) in index.node(node as u32).expect("a node").slots() {
+                let m = &merged[node * WIDTH + lane];
+                let direct = of_triangles(&under(&index, &slot));
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
+                assert!(close(m.area, direct.area));
+                assert!((m.centroid - direct.centroid).norm() < 1e-12);
+                assert!((m.normal - direct.normal).norm() < 1e-12);
+                assert!((m.spread - direct.spread).norm() < 1e-12, "node {node}");
+                for i in 0..3 {
+                    assert!((m.bend[i] - direct.bend[i]).norm() < 1e-12, "node {node}");
+                }
+                assert!(m.radius >= direct.radius - 1e-12);
+                slots += 1;
+            }
+        }
+        // Nodes of nodes were merged, not only leaves read.
+        assert!(slots > index.node_count() * 2, "{slots} slots");
+    }
+
+    /// The expansion's folded coefficients give the second-order formula term by term:
+    /// `N·u/d³ + tr spread/d³ − 3 uᵀ spread u/d⁵ + ½ (−3 (2 Σᵢ bendᵢ row i + tr bendᵢ)·u/d⁵ +
+    /// 15 Σᵢ uᵢ uᵀ bendᵢ u/d⁷)`, and that formula approaches the exact solid angle of a
+    /// cluster seen from afar.
+    #[test]
+    fn expansion_is_the_second_order_formula() {
+        let index = sphere_index();
+        let merged = slot_moments(&index).expect("moments");
+        let formula = |m: &Moment, u: &Vector3<f64>| {
+            let d = u.norm();
+            let (d3, d5, d7) = (d.powi(3), d.powi(5), d.powi(7));
+            let quadratic: f64 = (0..3).map(|i| u[i] * u.dot(&(m.bend[i] * u))).sum();
+            let rows: Vector3<f64> = (0..3).map(|i| m.bend[i].row(i).transpose()).sum();
+            let traces = Vector3::new(m.bend[0].trace(), m.bend[1].trace(), m.bend[2].trace());
+            m.normal.dot(u) / d3 + m.spread.trace() / d3 - 3.0 * u.dot(&(m.spread * u)) / d5
+                + 0.5 * (-3.0 * (2.0 * rows.dot(u) + traces.dot(u)) / d5 + 15.0 * quadratic / d7)
+        };
+        let mut rng = crate::generate::Rng::new(3);
+        for m in merged.iter().filter(|m| m.area > 0.0) {
+            let e = Expansion::of(m);
+            for _ in 0..20 {
+                let u = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 5.0;
+                let (ours, theirs) = (e.solid_angle(u.into(), u.norm()), formula(m, &u));
+                assert!((ours - theirs).abs() <= 1e-12 * (1.0 + theirs.abs()), "{ours} {theirs}");
+            }
+        }
+        // The whole sphere seen from outside subtends nothing, to second order in r/d.
+        let root: Vec<Moment> = index
+            .node(0)
+            .expect("the root")
+            .slots()
+            .map(|(lane, _)| merged[lane])
+            .collect();
+        let whole = merge(&root);
+        let far = Vector3::new(30.0, -20.0, 10.0);
+        let angle = Expansion::of(&whole).solid_angle(far.into(), far.norm());
+        assert!(angle.abs() < 1e-5, "{angle}");
     }
 }

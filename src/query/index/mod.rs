@@ -38,7 +38,7 @@ const NODE_COST: f64 = 1.0;
 
 /// Children of a node at most: a descent reads them together, so wider nodes mean fewer
 /// dependent memory reads per ray.
-const WIDTH: usize = 4;
+pub(in crate::query) const WIDTH: usize = 4;
 
 /// A child slot's `count` when the node has fewer children.
 const EMPTY: u32 = u32::MAX;
@@ -110,6 +110,27 @@ impl IndexNode {
     }
 }
 
+/// What an occupied child slot of a node holds.
+#[derive(Clone, Debug, PartialEq)]
+pub(in crate::query) enum Slot {
+    /// Another node, by its index (after its parent's).
+    Node(u32),
+    /// These triangles, in leaf order.
+    Triangles(std::ops::Range<usize>),
+}
+
+impl IndexNode {
+    /// The occupied child slots, in lane order: each one's lane and what it holds.
+    pub(in crate::query) fn slots(&self) -> impl Iterator<Item = (usize, Slot)> + '_ {
+        let lanes = self.start.iter().zip(&self.count).enumerate();
+        lanes.filter_map(|(lane, (&start, &count))| match count {
+            EMPTY => None,
+            0 => Some((lane, Slot::Node(start))),
+            n => Some((lane, Slot::Triangles(start as usize..start as usize + n as usize))),
+        })
+    }
+}
+
 /// The index of one model (see the module's documentation).
 #[derive(Debug)]
 pub(in crate::query) struct SurfaceIndex {
@@ -122,6 +143,11 @@ pub(in crate::query) struct SurfaceIndex {
 }
 
 impl SurfaceIndex {
+    /// How many nodes there are; node 0 is the root.
+    pub(in crate::query) fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
     /// Node `index`, if there is one.
     #[inline(always)]
     pub(in crate::query) fn node(&self, index: u32) -> Option<&IndexNode> {
