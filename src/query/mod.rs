@@ -34,6 +34,7 @@ mod distance;
 mod engine;
 mod hausdorff;
 mod index;
+mod order;
 mod pair_query;
 mod ray;
 mod span;

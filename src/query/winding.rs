@@ -10,6 +10,7 @@
 use super::closest::{closest_points, ClosestOptions};
 use super::engine::corrupt;
 use super::index::{Slot, SurfaceIndex, WIDTH};
+use super::order::map_in_space_order;
 use super::triangle::Triangle;
 use super::{check_points, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
@@ -17,7 +18,6 @@ use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
 use crate::tree::{NodeDefect, TreeView};
 use nalgebra::{Matrix3, Vector3};
-use rayon::prelude::*;
 use std::cmp::Ordering::Greater;
 use std::f64::consts::PI;
 
@@ -167,13 +167,10 @@ pub fn winding_numbers(
                 WindingAccuracy::Beta { beta } => Rule::Beta(beta),
             };
             let to_model = Pose::relative(self.pose, &Pose::identity());
-            self.points
-                .par_iter()
-                .map_init(Vec::new, |stack, p| {
-                    let local = to_model.apply(&Vector3::from(*p));
-                    descend(&index, &clusters, &local, rule, stack)
-                })
-                .collect()
+            map_in_space_order(self.points, Vec::new, |stack, p| {
+                let local = to_model.apply(&Vector3::from(*p));
+                descend(&index, &clusters, &local, rule, stack)
+            })
         }
     }
     model.visit(Visit {
