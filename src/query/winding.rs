@@ -261,32 +261,34 @@ impl Moment {
 }
 
 /// The surface index's children as clusters of triangles: for each node, what a descent
-/// reads of every child it meets (centroid, radius, area), the node's children side by
-/// side; and each child's [`Expansion`], read only for the clusters summed by moments.
+/// reads of every child it meets and, after it in memory, the children's [`Expansion`]s,
+/// read only for the clusters summed by moments.
 struct Clusters {
-    reach: Vec<Reach>,
-    /// Child `lane` of node `n` at `n * WIDTH + lane`.
-    expansions: Vec<Expansion>,
+    /// Node `n`'s children at `n`.
+    nodes: Vec<ClusterNode>,
     /// The whole model's area.
     area: f64,
 }
 
-/// The centroids (by coordinate), radii and areas of a node's children.
-#[derive(Clone, Copy, Debug, Default)]
-struct Reach {
+/// A node's children as clusters: their centroids (by coordinate), radii and areas side
+/// by side, then their expansions. One record, so that the reads of the first part draw
+/// the rest into cache behind them.
+#[derive(Clone, Copy, Debug)]
+struct ClusterNode {
     centroid: [[f64; WIDTH]; 3],
     radius: [f64; WIDTH],
     area: [f64; WIDTH],
+    expansions: [Expansion; WIDTH],
 }
 
 impl Clusters {
     fn of(index: &SurfaceIndex) -> Result<Clusters, QueryError> {
         let moments = slot_moments(index)?;
-        let reach = moments
+        let nodes = moments
             .chunks_exact(WIDTH)
             .map(|lanes| {
                 let m: [Moment; WIDTH] = lanes.try_into().unwrap_or([Moment::default(); WIDTH]);
-                Reach {
+                ClusterNode {
                     centroid: [
                         m.map(|m| m.centroid.x),
                         m.map(|m| m.centroid.y),
@@ -294,12 +296,12 @@ impl Clusters {
                     ],
                     radius: m.map(|m| m.radius),
                     area: m.map(|m| m.area),
+                    expansions: m.map(|m| Expansion::of(&m)),
                 }
             })
             .collect();
         Ok(Clusters {
-            reach,
-            expansions: moments.iter().map(Expansion::of).collect(),
+            nodes,
             area: moments.iter().take(WIDTH).map(|m| m.area).sum(),
         })
     }
@@ -532,6 +534,8 @@ impl Expansion {
 
 /// One point's winding number: clusters the rule accepts are summed by their expansions,
 /// leaves' triangles exactly, the rest opened; a node's children are met together.
+// Lanes count to WIDTH, the length of every array they index: no index can fail.
+#[allow(clippy::indexing_slicing)]
 fn descend(
     index: &SurfaceIndex,
     clusters: &Clusters,
@@ -544,23 +548,24 @@ fn descend(
     stack.clear();
     stack.push(0);
     while let Some(node) = stack.pop() {
-        let (Some(children), Some(reach)) = (index.node(node), clusters.reach.get(node as usize))
+        let (Some(children), Some(reach)) = (index.node(node), clusters.nodes.get(node as usize))
         else {
             return Err(missing());
         };
         // The children's offsets and distances, all at once.
-        let [cx, cy, cz] = &reach.centroid;
-        let ux: [f64; WIDTH] = std::array::from_fn(|lane| cx.get(lane).map_or(0.0, |c| c - p.x));
-        let uy: [f64; WIDTH] = std::array::from_fn(|lane| cy.get(lane).map_or(0.0, |c| c - p.y));
-        let uz: [f64; WIDTH] = std::array::from_fn(|lane| cz.get(lane).map_or(0.0, |c| c - p.z));
-        let lanes = ux.iter().zip(&uy).zip(&uz).zip(reach.radius.iter().zip(&reach.area));
-        let mut slots = children.slots().peekable();
-        for (lane, (((&x, &y), &z), (&r, &area))) in lanes.enumerate() {
-            let Some((_, slot)) = slots.next_if(|(at, _)| *at == lane) else {
+        let mut u = [[0.0; 3]; WIDTH];
+        let mut distance = [0.0; WIDTH];
+        for lane in 0..WIDTH {
+            let [x, y, z] = [0, 1, 2].map(|k| reach.centroid[k][lane] - p[k]);
+            u[lane] = [x, y, z];
+            distance[lane] = (x * x + y * y + z * z).sqrt();
+        }
+        for lane in 0..WIDTH {
+            let Some(slot) = children.slot(lane) else {
                 continue;
             };
             work.nodes_visited += 1;
-            let distance = (x * x + y * y + z * z).sqrt();
+            let (distance, r, area) = (distance[lane], reach.radius[lane], reach.area[lane]);
             if distance > r {
                 let gap = distance - r;
                 // The bound on what summing by moments errs by.
@@ -571,9 +576,7 @@ fn descend(
                     Rule::Beta(beta) => (distance > beta * r).then(error),
                 };
                 if let Some(error) = accepted {
-                    let at = node as usize * WIDTH + lane;
-                    let expansion = clusters.expansions.get(at).ok_or_else(missing)?;
-                    sum += expansion.solid_angle([x, y, z], distance);
+                    sum += reach.expansions[lane].solid_angle(u[lane], distance);
                     bound += error;
                     work.bv_disjoint += 1;
                     continue;

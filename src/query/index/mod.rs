@@ -120,14 +120,20 @@ pub(in crate::query) enum Slot {
 }
 
 impl IndexNode {
+    /// What child slot `lane` holds, if it is occupied.
+    #[inline(always)]
+    pub(in crate::query) fn slot(&self, lane: usize) -> Option<Slot> {
+        let (&start, &count) = self.start.get(lane).zip(self.count.get(lane))?;
+        match count {
+            EMPTY => None,
+            0 => Some(Slot::Node(start)),
+            n => Some(Slot::Triangles(start as usize..start as usize + n as usize)),
+        }
+    }
+
     /// The occupied child slots, in lane order: each one's lane and what it holds.
     pub(in crate::query) fn slots(&self) -> impl Iterator<Item = (usize, Slot)> + '_ {
-        let lanes = self.start.iter().zip(&self.count).enumerate();
-        lanes.filter_map(|(lane, (&start, &count))| match count {
-            EMPTY => None,
-            0 => Some((lane, Slot::Node(start))),
-            n => Some((lane, Slot::Triangles(start as usize..start as usize + n as usize))),
-        })
+        (0..WIDTH).filter_map(|lane| Some((lane, self.slot(lane)?)))
     }
 }
 
