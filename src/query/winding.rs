@@ -68,7 +68,9 @@ pub struct WindingResult {
     /// A proven bound on `|value − exact|` from the clusters summed by their moments: 0
     /// for [`WindingAccuracy::Exact`], at most the tolerance for
     /// [`WindingAccuracy::Bounded`], often far above the error made for
-    /// [`WindingAccuracy::Beta`]. Rounding comes on top.
+    /// [`WindingAccuracy::Beta`] (which bounds a cluster seen from `R` by
+    /// `A r³ / (π R⁵ (1 − 1/β)⁵)`, at least the bound below and cheaper). Rounding comes on
+    /// top.
     pub error_bound: f64,
     /// Work done: I counts clusters opened, D clusters summed by their moments, S
     /// triangles summed exactly.
@@ -164,7 +166,10 @@ pub fn winding_numbers(
                     Rule::Rate(tolerance / clusters.area)
                 }
                 WindingAccuracy::Bounded { .. } => Rule::Exact,
-                WindingAccuracy::Beta { beta } => Rule::Beta(beta),
+                WindingAccuracy::Beta { beta } => Rule::Beta {
+                    beta,
+                    bound: 1.0 / (PI * (1.0 - 1.0 / beta).powi(5)),
+                },
             };
             let to_model = Pose::relative(self.pose, &Pose::identity());
             map_in_space_order(self.points, Vec::new, |stack, p| {
@@ -443,8 +448,9 @@ enum Rule {
     Exact,
     /// Those whose error bound is within this many times their area.
     Rate(f64),
-    /// Those farther than this many times their radius.
-    Beta(f64),
+    /// Those farther than `beta` times their radius; their error bound is `bound` times
+    /// `A r³ / d⁵` (`d` the distance, then `d − r > d (1 − 1/β)`).
+    Beta { beta: f64, bound: f64 },
 }
 
 /// A cluster's moments as its far-field expansion reads them. Seen from a point at `u`
@@ -513,9 +519,9 @@ impl Expansion {
         }
     }
 
-    /// The cluster's solid angle seen from `u` away from its centroid, `d = |u|`.
+    /// The cluster's solid angle seen from `u` away from its centroid, `inverse = 1/|u|`.
     #[inline(always)]
-    fn solid_angle(&self, [x, y, z]: [f64; 3], d: f64) -> f64 {
+    fn solid_angle(&self, [x, y, z]: [f64; 3], inverse: f64) -> f64 {
         let [nx, ny, nz] = self.normal;
         let [xx, yy, zz, xy, yz, zx] = self.square;
         let [vx, vy, vz] = self.linear;
@@ -527,8 +533,8 @@ impl Expansion {
             + y * y * (yyy * y + xyy * x + yyz * z)
             + z * z * (zzz * z + xzz * x + yzz * y)
             + xyz * x * y * z;
-        let inverse2 = 1.0 / (d * d);
-        inverse2 / d * (first - inverse2 * (second - inverse2 * third))
+        let inverse2 = inverse * inverse;
+        inverse2 * inverse * (first - inverse2 * (second - inverse2 * third))
     }
 }
 
@@ -567,16 +573,22 @@ fn descend(
             work.nodes_visited += 1;
             let (distance, r, area) = (distance[lane], reach.radius[lane], reach.area[lane]);
             if distance > r {
-                let gap = distance - r;
-                // The bound on what summing by moments errs by.
-                let error = || area * r * r * r / (PI * gap * gap * gap * gap * gap);
-                let accepted = match rule {
+                let inverse = 1.0 / distance;
+                // The bound on what summing by moments errs by, `A r³ / (π (d − r)⁵)`.
+                let error = match rule {
                     Rule::Exact => None,
-                    Rule::Rate(rate) => Some(error()).filter(|e| *e <= rate * area),
-                    Rule::Beta(beta) => (distance > beta * r).then(error),
+                    Rule::Rate(rate) => {
+                        let gap = distance - r;
+                        let error = area * r * r * r / (PI * gap.powi(5));
+                        (error <= rate * area).then_some(error)
+                    }
+                    // Within that bound; from 1/d, which the expansion needs anyway.
+                    Rule::Beta { beta, bound } => {
+                        (distance > beta * r).then(|| bound * area * r * r * r * inverse.powi(5))
+                    }
                 };
-                if let Some(error) = accepted {
-                    sum += reach.expansions[lane].solid_angle(u[lane], distance);
+                if let Some(error) = error {
+                    sum += reach.expansions[lane].solid_angle(u[lane], inverse);
                     bound += error;
                     work.bv_disjoint += 1;
                     continue;
@@ -686,7 +698,7 @@ mod tests {
             let e = Expansion::of(m);
             for _ in 0..20 {
                 let u = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 5.0;
-                let (ours, theirs) = (e.solid_angle(u.into(), u.norm()), formula(m, &u));
+                let (ours, theirs) = (e.solid_angle(u.into(), 1.0 / u.norm()), formula(m, &u));
                 assert!((ours - theirs).abs() <= 1e-12 * (1.0 + theirs.abs()), "{ours} {theirs}");
             }
         }
@@ -699,7 +711,7 @@ mod tests {
             .collect();
         let whole = merge(&root);
         let far = Vector3::new(30.0, -20.0, 10.0);
-        let angle = Expansion::of(&whole).solid_angle(far.into(), far.norm());
+        let angle = Expansion::of(&whole).solid_angle(far.into(), 1.0 / far.norm());
         assert!(angle.abs() < 1e-5, "{angle}");
     }
 }
