@@ -36,7 +36,11 @@ fn main() {
     // `SORTED=1`: points in grid-cell order, to see what coherence is worth.
     let mut points = points;
     if std::env::var("SORTED").is_ok() {
-        let cell = |p: &[f64; 3]| std::array::from_fn::<i64, 3, _>(|k| ((p[k] - lo[k]) * 16.0 / (hi[k] - lo[k])).floor() as i64);
+        let cell = |p: &[f64; 3]| {
+            std::array::from_fn::<i64, 3, _>(|k| {
+                ((p[k] - lo[k]) * 16.0 / (hi[k] - lo[k])).floor() as i64
+            })
+        };
         points.sort_by_key(cell);
     }
     let options = WindingOptions {

@@ -106,17 +106,28 @@ mod tests {
         // Consecutive points are near: a third of the mean step of the caller's order.
         let mut order: Vec<(u64, usize)> = codes(&points).into_iter().zip(0..).collect();
         order.sort_unstable();
-        let step = |a: &[f64; 3], b: &[f64; 3]| {
-            (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
-        };
+        let step =
+            |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
         let mean = |path: &[usize]| {
-            path.windows(2).map(|w| step(&points[w[0]], &points[w[1]])).sum::<f64>() / 999.0
+            path.windows(2)
+                .map(|w| step(&points[w[0]], &points[w[1]]))
+                .sum::<f64>()
+                / 999.0
         };
         let given: Vec<usize> = (0..points.len()).collect();
         let spatial: Vec<usize> = order.iter().map(|&(_, i)| i).collect();
-        assert!(mean(&spatial) < mean(&given) / 3.0, "{} {}", mean(&spatial), mean(&given));
+        assert!(
+            mean(&spatial) < mean(&given) / 3.0,
+            "{} {}",
+            mean(&spatial),
+            mean(&given)
+        );
         // An error is returned as such.
-        let failed = map_in_space_order(&points, || (), |_, p| if p[1] > 0.9 { Err(p[1]) } else { Ok(()) });
+        let failed = map_in_space_order(
+            &points,
+            || (),
+            |_, p| if p[1] > 0.9 { Err(p[1]) } else { Ok(()) },
+        );
         assert!(failed.is_err());
     }
 }

@@ -216,7 +216,7 @@ fn the_approximation_stays_within_its_bound_of_the_exact_sum() {
                 );
             }
             if let WindingAccuracy::Beta { .. } = accuracy {
-                // Measured: about 1e-2 at β = 2 near the cow's surface.
+                // Near the cow's surface, where the expansion errs most.
                 assert!(worst < 5e-2, "{options:?} {accuracy:?}: {worst}");
             }
         }
