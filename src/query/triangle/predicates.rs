@@ -328,13 +328,8 @@ mod tests {
     /// exact routine.
     #[test]
     fn plane_side_is_exact_where_the_normal_cancels() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut unit = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::generate::Rng::new(11);
+        let mut unit = || rng.unit();
         let mut decided_by_rounding = 0;
         let coordinate = |u: f64| 400.0 * u - 200.0;
         for _ in 0..20_000 {
