@@ -49,13 +49,10 @@ fn codes(points: &[[f64; 3]]) -> Vec<u64> {
         }
     }
     let cells = f64::from((1u32 << BITS) - 1);
+    // (A zero extent makes the scale infinite and every offset 0 × ∞ = NaN, which the
+    // cast below saturates to cell 0, as it should.)
     let scale = std::array::from_fn::<f64, 3, _>(|k| {
-        let extent = hi.get(k).zip(lo.get(k)).map_or(0.0, |(h, l)| h - l);
-        if extent > 0.0 {
-            cells / extent
-        } else {
-            0.0
-        }
+        cells / hi.get(k).zip(lo.get(k)).map_or(0.0, |(h, l)| h - l)
     });
     points
         .iter()
