@@ -30,19 +30,10 @@ fn main() {
         }
     }
     let mut rng = Rng::new(7);
+    // (In the caller's order: `winding_numbers` orders them in space itself.)
     let points: Vec<[f64; 3]> = (0..count)
         .map(|_| std::array::from_fn(|k| lo[k] + (hi[k] - lo[k]) * rng.unit()))
         .collect();
-    // `SORTED=1`: points in grid-cell order, to see what coherence is worth.
-    let mut points = points;
-    if std::env::var("SORTED").is_ok() {
-        let cell = |p: &[f64; 3]| {
-            std::array::from_fn::<i64, 3, _>(|k| {
-                ((p[k] - lo[k]) * 16.0 / (hi[k] - lo[k])).floor() as i64
-            })
-        };
-        points.sort_by_key(cell);
-    }
     let options = WindingOptions {
         accuracy: WindingAccuracy::Beta { beta },
     };

@@ -223,10 +223,9 @@ pub fn signed_distances(
 }
 
 /// What a cluster of triangles (a child of a surface index node) looks like from afar
-/// (model frame): its area, its
-/// area-weighted normal `N = Σ A n`, its area-weighted centroid `c`, the moments
-/// `spread = Σ n ∫ (x − c)ᵀ dA` and `bend[i] = Σ nᵢ ∫ (x − c)(x − c)ᵀ dA` over its
-/// triangles (unit normals `n`), and the radius about `c` within which all its corners lie.
+/// (model frame): its area, its area-weighted normal `N = Σ A n`, its area-weighted
+/// centroid `c`, and the moments `spread = Σ n ∫ (x − c)ᵀ dA` and
+/// `bend[i] = Σ nᵢ ∫ (x − c)(x − c)ᵀ dA` over its triangles (unit normals `n`).
 #[derive(Clone, Copy, Debug, Default)]
 struct Moment {
     area: f64,
@@ -234,37 +233,6 @@ struct Moment {
     centroid: Vector3<f64>,
     spread: Matrix3<f64>,
     bend: [Matrix3<f64>; 3],
-    /// `Σᵢ bend[i]` row `i`, and the traces of `bend`: what the expansion reads of it.
-    bend_rows: Vector3<f64>,
-    bend_traces: Vector3<f64>,
-    radius: f64,
-}
-
-impl Moment {
-    /// The moment of these parts, with what the expansion reads of `bend`.
-    fn new(
-        area: f64,
-        normal: Vector3<f64>,
-        centroid: Vector3<f64>,
-        spread: Matrix3<f64>,
-        bend: [Matrix3<f64>; 3],
-        radius: f64,
-    ) -> Moment {
-        Moment {
-            area,
-            normal,
-            centroid,
-            spread,
-            bend,
-            bend_rows: bend
-                .iter()
-                .enumerate()
-                .map(|(i, b)| b.row(i).transpose())
-                .sum(),
-            bend_traces: Vector3::new(bend[0].trace(), bend[1].trace(), bend[2].trace()),
-            radius,
-        }
-    }
 }
 
 /// The surface index's children as clusters of triangles: for each node, what a descent
@@ -290,10 +258,11 @@ struct ClusterNode {
 
 impl Clusters {
     fn of(index: &SurfaceIndex) -> Result<Clusters, QueryError> {
-        let moments = slot_moments(index)?;
+        let (moments, radii) = slot_moments(index)?;
         let nodes = moments
             .chunks_exact(WIDTH)
-            .map(|lanes| {
+            .zip(radii.chunks_exact(WIDTH))
+            .map(|(lanes, radius)| {
                 let m: [Moment; WIDTH] = lanes.try_into().unwrap_or([Moment::default(); WIDTH]);
                 ClusterNode {
                     centroid: [
@@ -301,7 +270,7 @@ impl Clusters {
                         m.map(|m| m.centroid.y),
                         m.map(|m| m.centroid.z),
                     ],
-                    radius: m.map(|m| m.radius),
+                    radius: radius.try_into().unwrap_or([0.0; WIDTH]),
                     area: m.map(|m| m.area),
                     expansions: m.map(|m| Expansion::of(&m)),
                 }
@@ -314,18 +283,20 @@ impl Clusters {
     }
 }
 
-/// The moment of every child slot of `index`, child `lane` of node `n` at `n * WIDTH +
-/// lane` (an empty slot's is zero): a node's children are after it, so in reverse order a
-/// child node's slots are done before the slot holding it merges them.
-fn slot_moments(index: &SurfaceIndex) -> Result<Vec<Moment>, QueryError> {
+/// The moment of every child slot of `index`, and the radius about its centroid within
+/// which all its corners lie; child `lane` of node `n` at `n * WIDTH + lane` (an empty
+/// slot's are zero): a node's children are after it, so in reverse order a child node's
+/// slots are done before the slot holding it merges them.
+fn slot_moments(index: &SurfaceIndex) -> Result<(Vec<Moment>, Vec<f64>), QueryError> {
     let missing = || corrupt(Side::A, NodeDefect::Missing);
     let mut out = vec![Moment::default(); index.node_count() * WIDTH];
+    let mut radii = vec![0.0; index.node_count() * WIDTH];
     // Each slot's triangles, as a range of leaf order holding them all.
     let mut spans = vec![0..0; index.node_count() * WIDTH];
     for node in (0..index.node_count()).rev() {
         let slots = index.node(node as u32).ok_or_else(missing)?.slots();
         for (lane, slot) in slots {
-            let (mut m, span) = match slot {
+            let (m, span) = match slot {
                 Slot::Node(child) => {
                     let kids: Vec<usize> = (index.node(child).ok_or_else(missing)?.slots())
                         .map(|(lane, _)| child as usize * WIDTH + lane)
@@ -346,8 +317,8 @@ fn slot_moments(index: &SurfaceIndex) -> Result<Vec<Moment>, QueryError> {
                 }
             };
             // The radius over the corners themselves (a node's triangles are contiguous in
-            // leaf order): merging the children's balls overstates it, and every cluster
-            // that looks larger than it is is opened where its moments would do.
+            // leaf order): merging the children's balls would overstate it, and every
+            // cluster that looks larger than it is is opened where its moments would do.
             let mut radius = 0.0f64;
             for i in span.clone() {
                 let (t, _) = index.triangle(i).ok_or_else(missing)?;
@@ -355,12 +326,13 @@ fn slot_moments(index: &SurfaceIndex) -> Result<Vec<Moment>, QueryError> {
                     radius = radius.max((c - m.centroid).norm());
                 }
             }
-            m.radius = m.radius.min(radius);
-            *out.get_mut(node * WIDTH + lane).ok_or_else(missing)? = m;
-            *spans.get_mut(node * WIDTH + lane).ok_or_else(missing)? = span;
+            let at = node * WIDTH + lane;
+            *out.get_mut(at).ok_or_else(missing)? = m;
+            *radii.get_mut(at).ok_or_else(missing)? = radius;
+            *spans.get_mut(at).ok_or_else(missing)? = span;
         }
     }
-    Ok(out)
+    Ok((out, radii))
 }
 
 /// The moment of the union of clusters.
@@ -392,11 +364,13 @@ fn merge(kids: &[Moment]) -> Moment {
                 + delta * delta.transpose() * *ni;
         }
     }
-    let radius = kids
-        .iter()
-        .map(|k| (k.centroid - centroid).norm() + k.radius)
-        .fold(0.0, f64::max);
-    Moment::new(area, normal, centroid, spread, bend, radius)
+    Moment {
+        area,
+        normal,
+        centroid,
+        spread,
+        bend,
+    }
 }
 
 /// The moment of a cluster of triangles, from the triangles themselves.
@@ -430,12 +404,13 @@ fn of_triangles(triangles: &[Triangle]) -> Moment {
             *b += second * *ni;
         }
     }
-    let radius = triangles
-        .iter()
-        .flatten()
-        .map(|c| (c - centroid).norm())
-        .fold(0.0, f64::max);
-    Moment::new(area, normal, centroid, spread, bend, radius)
+    Moment {
+        area,
+        normal,
+        centroid,
+        spread,
+        bend,
+    }
 }
 
 /// The area-weighted centroid, or for a cluster of no area the mean of `points`.
@@ -482,7 +457,7 @@ enum Rule {
 /// `g = ∇φ`, `φ(x) = −1/|x − p|`, expanded about the centroid (`∂ᵢφ = uᵢ/d³`,
 /// `∂ᵢⱼφ = δᵢⱼ/d³ − 3uᵢuⱼ/d⁵`, `∂ᵢⱼₖφ = −3(δᵢⱼuₖ + δᵢₖuⱼ + δⱼₖuᵢ)/d⁵ + 15uᵢuⱼuₖ/d⁷`)
 /// against `N`, `spread` and `bend / 2`. Kept are the coefficients of those forms, the
-/// constants folded in: 23 numbers where the moment has 40.
+/// constants folded in: 23 numbers for the 39 of `N`, `spread` and `bend`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Expansion {
     /// `N`.
@@ -501,7 +476,14 @@ struct Expansion {
 impl Expansion {
     fn of(m: &Moment) -> Expansion {
         let s = &m.spread;
-        let linear = (m.bend_rows * 2.0 + m.bend_traces) * 1.5;
+        let bend = &m.bend;
+        let rows: Vector3<f64> = bend
+            .iter()
+            .enumerate()
+            .map(|(i, b)| b.row(i).transpose())
+            .sum();
+        let traces = Vector3::new(bend[0].trace(), bend[1].trace(), bend[2].trace());
+        let linear = (rows * 2.0 + traces) * 1.5;
         let mut cubic = [0.0; 10];
         for (i, b) in m.bend.iter().enumerate() {
             for (j, row) in b.row_iter().enumerate() {
@@ -662,7 +644,7 @@ mod tests {
     #[test]
     fn merged_moments_equal_the_moments_of_the_triangles() {
         let index = sphere_index();
-        let merged = slot_moments(&index).expect("moments");
+        let (merged, radii) = slot_moments(&index).expect("moments");
         // The triangles under a slot.
         fn under(index: &SurfaceIndex, slot: &Slot) -> Vec<Triangle> {
             match slot {
@@ -691,7 +673,14 @@ mod tests {
                 for i in 0..3 {
                     assert!((m.bend[i] - direct.bend[i]).norm() < 1e-12, "node {node}");
                 }
-                assert!((m.radius - direct.radius).abs() < 1e-12, "node {node}");
+                let corners = under(&index, &slot).into_iter().flatten();
+                let reach = corners
+                    .map(|c| (c - direct.centroid).norm())
+                    .fold(0.0, f64::max);
+                assert!(
+                    (radii[node * WIDTH + lane] - reach).abs() < 1e-12,
+                    "node {node}"
+                );
                 slots += 1;
             }
         }
@@ -706,7 +695,7 @@ mod tests {
     #[test]
     fn expansion_is_the_second_order_formula() {
         let index = sphere_index();
-        let merged = slot_moments(&index).expect("moments");
+        let (merged, _) = slot_moments(&index).expect("moments");
         let formula = |m: &Moment, u: &Vector3<f64>| {
             let d = u.norm();
             let (d3, d5, d7) = (d.powi(3), d.powi(5), d.powi(7));
