@@ -4,7 +4,7 @@
 
 use super::engine::corrupt;
 use super::index::ray::Slabs;
-use super::index::{Child, SurfaceIndex};
+use super::index::{Child, SurfaceIndex, WIDTH};
 use super::triangle::{RaySpace, Triangle};
 use super::{source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
@@ -386,9 +386,11 @@ fn descend<B: BoundingVolume, C: Collect>(
             let (entered, n, tested) = ray.slabs.entered(node, reach.min(t_max));
             work.nodes_visited += tested as u64;
             work.bv_disjoint += (tested - n) as u64;
-            let mut nearest_first = entered.iter().take(n);
-            next = nearest_first.next().copied();
-            stack.extend(nearest_first.rev());
+            // The nearest is taken next, the others wait, farthest deepest.
+            if let Some((nearest, others)) = entered.get(WIDTH - n..).and_then(|e| e.split_last()) {
+                next = Some(*nearest);
+                stack.extend_from_slice(others);
+            }
             continue;
         }
         let (start, count) = (taken.start as usize, taken.count as usize);

@@ -17,6 +17,7 @@
 //! the same exact triangle tests as before.
 
 pub(in crate::query) mod point;
+mod quad;
 pub(in crate::query) mod ray;
 
 use super::engine::triangle;
@@ -84,6 +85,13 @@ impl Child {
 }
 
 impl IndexNode {
+    /// A bit per slot, set where the slot is occupied.
+    #[inline(always)]
+    fn occupied(&self) -> u32 {
+        let [a, b, c, d] = self.count.map(|c| u32::from(c != EMPTY));
+        a | b << 1 | c << 2 | d << 3
+    }
+
     /// The children whose key (one per slot) `keep` accepts, in slot order; how many they
     /// are; and how many children were keyed (empty slots are not).
     #[inline(always)]

@@ -1,12 +1,15 @@
 //! Rays through the surface index: which children's boxes a ray enters, nearest first.
 
+use super::quad::Quad;
 use super::{Child, IndexNode, WIDTH};
 
 /// A ray in the model frame, set up for slab tests.
 pub(in crate::query) struct Slabs {
     origin: [f64; 3],
-    direction: [f64; 3],
     inverse: [f64; 3],
+    /// Per axis, whether the ray runs toward smaller coordinates: it then meets a box's
+    /// `hi` plane first. Chosen once per ray, so a node's lanes need no comparison.
+    negative: [bool; 3],
 }
 
 /// How much a computed slab parameter may be off, relative to itself: the difference,
@@ -16,90 +19,97 @@ const SLAB_ROUNDING: f64 = 4.0 * f64::EPSILON;
 impl Slabs {
     /// The slabs of the ray `origin + t direction` (finite, direction not zero).
     pub(in crate::query) fn new(origin: [f64; 3], direction: [f64; 3]) -> Slabs {
+        // A zero direction's inverse is an infinity of its sign (see `entries`); one too
+        // short to invert is NaN instead, so its axis prunes nothing.
+        let inverse = direction.map(|d| match 1.0 / d {
+            i if d != 0.0 && !i.is_finite() => f64::NAN,
+            i => i,
+        });
         Slabs {
             origin,
-            direction,
-            inverse: direction.map(|d| 1.0 / d),
+            inverse,
+            negative: inverse.map(|i| i < 0.0),
         }
     }
 
-    /// Where the ray enters each child box of `node` before parameter `reach`: a lower
-    /// bound of the exact entry, or +∞ where it does not. Never +∞ for a box the ray meets
-    /// at a `t` in `[0, reach]` (of a damaged file's NaN boxes, only that it answers).
+    /// Where the ray enters each child box of `node` before parameter `reach` (a lower
+    /// bound of the exact entry), and a bit per slot set where it does and the slot is
+    /// occupied. The bit is set for every box the ray meets at a `t` in `[0, reach]` (of a
+    /// damaged file's NaN boxes, only that it answers).
+    ///
+    /// An axis the ray is parallel to needs no case of its own: its inverse is infinite,
+    /// so a plane on the origin's far side gives an infinite entry or a negative infinite
+    /// exit (a miss) and one on its near side prunes nothing; a plane through the origin
+    /// gives NaN, which `max` and `min` pass over (on the boundary counts as inside), as
+    /// they pass over every value of an axis whose inverse is NaN.
+    // Axes count to 3, the length of every array they index.
+    #[allow(clippy::indexing_slicing)]
     #[inline(always)]
-    fn entries(&self, node: &IndexNode, reach: f64) -> [f64; WIDTH] {
-        let mut near = [0.0f64; WIDTH];
-        let mut far = [reach; WIDTH];
-        let axes = node.lo.iter().zip(&node.hi);
-        let rays = self.origin.iter().zip(&self.inverse).zip(&self.direction);
-        for ((lo, hi), ((&o, &inverse), &direction)) in axes.zip(rays) {
-            let lanes = near.iter_mut().zip(far.iter_mut()).zip(lo.iter().zip(hi));
-            if inverse.is_finite() {
-                for ((near, far), (&lo, &hi)) in lanes {
-                    let t0 = (f64::from(lo) - o) * inverse;
-                    let t1 = (f64::from(hi) - o) * inverse;
-                    let (a, b) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-                    // (Plain comparisons: NaN, of a damaged file, compares false.)
-                    if a > *near {
-                        *near = a;
-                    }
-                    if b < *far {
-                        *far = b;
-                    }
-                }
-            } else if direction == 0.0 {
-                // Parallel to the slab: outside it, the ray misses. (A direction so short
-                // that its inverse overflows prunes nothing on its axis.)
-                for ((_, far), (&lo, &hi)) in lanes {
-                    if o < f64::from(lo) || o > f64::from(hi) {
-                        *far = f64::NEG_INFINITY;
-                    }
-                }
-            }
+    fn entries(&self, node: &IndexNode, reach: f64) -> ([f64; WIDTH], u32) {
+        let mut near = Quad::splat(0.0);
+        let mut far = Quad::splat(reach);
+        for axis in 0..3 {
+            let (o, inverse) = (
+                Quad::splat(self.origin[axis]),
+                Quad::splat(self.inverse[axis]),
+            );
+            let (first, last) = if self.negative[axis] {
+                (&node.hi[axis], &node.lo[axis])
+            } else {
+                (&node.lo[axis], &node.hi[axis])
+            };
+            near = ((Quad::widen(first) - o) * inverse).max(near);
+            far = ((Quad::widen(last) - o) * inverse).min(far);
         }
         // Widened by their rounding once: `x ∓ |x| r` is increasing in `x`, so this is
-        // the largest (smallest) of the widened bounds of the three slabs.
-        std::array::from_fn(|lane| {
-            let (near, far) = (near.get(lane).copied(), far.get(lane).copied());
-            let (Some(near), Some(far)) = (near, far) else {
-                return f64::INFINITY;
-            };
-            let (near, far) = (
-                near - near.abs() * SLAB_ROUNDING,
-                far + far.abs() * SLAB_ROUNDING,
-            );
-            if near <= far {
-                near
-            } else {
-                f64::INFINITY
-            }
-        })
+        // the largest (smallest) of the widened bounds of the three slabs. (An infinite
+        // entry or exit becomes NaN, and a miss.)
+        let rounding = Quad::splat(SLAB_ROUNDING);
+        let near = near - near.abs() * rounding;
+        let far = far + far.abs() * rounding;
+        (near.to_array(), near.le_mask(far) & node.occupied())
     }
 
-    /// The children of `node` the ray enters before `reach`, nearest first, and how many
-    /// there are; the other slots are unused.
+    /// The children of `node` the ray enters before `reach`, farthest first and after
+    /// `WIDTH − n` unused slots (so the nearest is last, and the others go on a stack as
+    /// they lie); `n`, how many there are; and how many children were tested (empty slots
+    /// are not).
+    // Lanes count to WIDTH (two bits), the length of every array they index.
+    #[allow(clippy::indexing_slicing)]
     #[inline(always)]
     pub(in crate::query) fn entered(
         &self,
         node: &IndexNode,
         reach: f64,
     ) -> ([Child; WIDTH], usize, usize) {
-        let (mut entered, n, tested) = node.kept(self.entries(node, reach), |e| e < f64::INFINITY);
-        // Insertion sort: at most four, and a library sort is not inlined here.
-        for i in 1..n {
-            let mut j = i;
-            while j > 0 {
-                let (Some(a), Some(b)) = (entered.get(j - 1), entered.get(j)) else {
-                    break;
-                };
-                if a.key <= b.key {
-                    break;
-                }
-                entered.swap(j - 1, j);
-                j -= 1;
+        let (entries, mask) = self.entries(node, reach);
+        // Each entered child's key with its lane in the two low bits, as an integer: for
+        // keys of at least 0 (an entry is) the bits order as the values do, and clearing
+        // two keeps a lower bound. Missed children sort first, unused.
+        let packed: [u64; WIDTH] = std::array::from_fn(|lane| {
+            if mask >> lane & 1 == 1 {
+                entries[lane].to_bits() & !3 | lane as u64
+            } else {
+                u64::MAX
             }
+        });
+        // A sorting network, largest first, of integer minima and maxima: no branch (on
+        // the keys as floats, the compiler branched on every exchange).
+        let mut packed = packed;
+        for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+            let (a, b) = (packed[i], packed[j]);
+            (packed[i], packed[j]) = (a.max(b), a.min(b));
         }
-        (entered, n, tested)
+        let children = packed.map(|bits| {
+            let lane = (bits & 3) as usize;
+            Child {
+                key: f64::from_bits(bits & !3),
+                start: node.start[lane],
+                count: node.count[lane],
+            }
+        });
+        let tested = node.occupied().count_ones() as usize;
+        (children, mask.count_ones() as usize, tested)
     }
 }
 
@@ -123,7 +133,7 @@ mod tests {
     fn entry(s: &Slabs, n: &IndexNode, reach: f64) -> Option<f64> {
         let (entered, count, tested) = s.entered(n, reach);
         assert_eq!(tested, 1);
-        (count == 1).then_some(entered[0].key)
+        (count == 1).then_some(entered[WIDTH - 1].key)
     }
 
     #[test]
@@ -154,7 +164,7 @@ mod tests {
     }
 
     #[test]
-    fn children_come_nearest_first_and_empty_slots_are_not_tested() {
+    fn children_come_farthest_first_and_empty_slots_are_not_tested() {
         let mut n = IndexNode::EMPTY;
         let unit = |x: f64| Bounds {
             lo: [x, 0.0, 0.0],
@@ -167,8 +177,8 @@ mod tests {
         let s = Slabs::new([-1.0, 0.5, 0.5], [1.0, 0.0, 0.0]);
         let (entered, count, tested) = s.entered(&n, f64::INFINITY);
         assert_eq!((count, tested), (3, 3));
-        let order: Vec<(u32, u32)> = entered[..3].iter().map(|e| (e.start, e.count)).collect();
-        assert_eq!(order, [(20, 3), (30, 0), (10, 0)]);
+        let order: Vec<(u32, u32)> = entered[1..].iter().map(|e| (e.start, e.count)).collect();
+        assert_eq!(order, [(10, 0), (30, 0), (20, 3)]);
         // Up to t = 4 (x = 3) the farthest box is not entered.
         let (_, count, _) = s.entered(&n, 4.0);
         assert_eq!(count, 2);
