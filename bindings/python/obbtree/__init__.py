@@ -55,6 +55,7 @@ from ._obbtree import (
     _closest,
     _inside,
     _ray,
+    _ray_all,
     collide,
     distance,
     hausdorff,
@@ -327,27 +328,17 @@ def ray(
     o, d = (np.broadcast_to(a, (n, 3)) if a.ndim == 1 else a for a in (o, d))
     if len(o) != len(d):
         raise OptionError(f"origins and directions differ in length: {len(o)} and {len(d)}")
-    index, t, tri, bary, normal = _ray(
-        tree, pose, np.ascontiguousarray(o), np.ascontiguousarray(d), float(t_max), mode,
-        orthonormalize, threads,
-    )
-    point = o[index] + t[:, None] * d[index]
+    o, d = np.ascontiguousarray(o), np.ascontiguousarray(d)
     if mode == "all":
+        index, t, tri, point, bary, normal = _ray_all(
+            tree, pose, o, d, float(t_max), orthonormalize, threads
+        )
         count = np.bincount(index, minlength=n).astype(np.int64)
         result: Union[RayResult, RayHits] = RayHits(count, index, t, tri, point, bary, normal)
     else:
-        hit = np.zeros(n, dtype=bool)
-        hit[index] = True
-        full_t = np.full(n, np.inf)
-        full_t[index] = t
-        full_tri = np.full(n, -1, dtype=np.int64)
-        full_tri[index] = tri
-        rows = []
-        for values in (point, bary, normal):
-            full = np.full((n, 3), np.nan)
-            full[index] = values
-            rows.append(full)
-        result = RayResult(hit, full_t, full_tri, *rows)
+        result = RayResult(
+            *_ray(tree, pose, o, d, float(t_max), mode, orthonormalize, threads)
+        )
     # (Not dataclasses.astuple: it copies the arrays.)
     for field in dataclasses.fields(result):
         getattr(result, field.name).flags.writeable = False

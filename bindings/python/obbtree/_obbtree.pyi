@@ -283,9 +283,26 @@ def _ray(
     orthonormalize: bool,
     threads: Optional[int],
 ) -> Tuple[
+    npt.NDArray[np.bool_],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+]: ...
+def _ray_all(
+    tree: Tree,
+    pose: Poses,
+    origins: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64],
+    t_max: float,
+    orthonormalize: bool,
+    threads: Optional[int],
+) -> Tuple[
     npt.NDArray[np.int64],
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
 ]: ...

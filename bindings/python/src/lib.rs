@@ -145,6 +145,7 @@ fn _obbtree(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::hausdorff, m)?)?;
     m.add_function(wrap_pyfunction!(closest::_closest, m)?)?;
     m.add_function(wrap_pyfunction!(ray::_ray, m)?)?;
+    m.add_function(wrap_pyfunction!(ray::_ray_all, m)?)?;
     m.add_function(wrap_pyfunction!(winding::_inside, m)?)?;
     m.add_function(wrap_pyfunction!(queries::_time_rust_loop, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -4,15 +4,14 @@ use crate::errors::{Failure, Kind};
 use crate::poses::single_pose;
 use crate::queries::detached;
 use crate::tree::Tree;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use obbtree::query::{all_ray_hits, cast_rays, Ray, RayHit, RayMode, RayOptions};
 use pyo3::prelude::*;
 
-/// The native half of `obbtree.ray` (which documents it): `origins` and `directions`
-/// (N, 3) float64 arrays, `mode` one of `closest`, `any`, `all`. Returns the hits of
-/// every ray, ray by ray: `(ray, t, tri, barycentric, normal)` as (M,) int64, (M,)
-/// float64, (M,) int64, (M, 3) float64, (M, 3) float64 arrays, where M is the number of
-/// hits (at most one per ray unless `mode` is `all`).
+/// The native half of `obbtree.ray` (which documents it) in modes `closest` and `any`:
+/// `origins` and `directions` (N, 3) float64 arrays. Returns, ray by ray, `(hit, t, tri,
+/// point, barycentric, normal)` as (N,) bool, (N,) float64 (inf on a miss), (N,) int64
+/// (-1), and three (N, 3) float64 arrays (NaN).
 #[pyfunction]
 #[pyo3(signature = (tree, pose, origins, directions, t_max, mode, orthonormalize, threads))]
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
@@ -27,14 +26,91 @@ pub fn _ray<'py>(
     orthonormalize: bool,
     threads: Option<i64>,
 ) -> PyResult<(
-    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<i64>>,
-    Bound<'py, numpy::PyArray2<f64>>,
-    Bound<'py, numpy::PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
 )> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
+    let rays = ray_rows(&origins, &directions)?;
+    let mode = match mode {
+        "closest" => RayMode::Closest,
+        "any" => RayMode::Any,
+        other => {
+            return Err(Failure::new(
+                Kind::Option,
+                format!("mode must be \"closest\", \"any\" or \"all\", got {other:?}"),
+            )
+            .into())
+        }
+    };
+    let answers = detached(py, threads, || {
+        cast_rays(&file, &pose, &rays, &RayOptions { mode, t_max }).map_err(Failure::from)
+    })?;
+    // Dense columns filled in one pass here: scattering hits into them with NumPy took
+    // about as long as casting the rays.
+    let n = answers.len();
+    let mut columns = Columns::with_capacity(n);
+    for (ray, answer) in rays.iter().zip(&answers) {
+        columns.push(ray, answer.hit.as_ref());
+    }
+    let hit = answers
+        .iter()
+        .map(|a| a.hit.is_some())
+        .collect::<Vec<bool>>();
+    let (t, tri, point, bary, normal) = columns.into_arrays(py)?;
+    Ok((PyArray1::from_vec(py, hit), t, tri, point, bary, normal))
+}
+
+/// The native half of `obbtree.ray` in mode `all`: every hit of every ray, ray by ray and
+/// by increasing `t`, as `(ray, t, tri, point, barycentric, normal)`: (M,) int64, (M,)
+/// float64, (M,) int64 and three (M, 3) float64 arrays, where M is the number of hits.
+#[pyfunction]
+#[pyo3(signature = (tree, pose, origins, directions, t_max, orthonormalize, threads))]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+pub fn _ray_all<'py>(
+    py: Python<'py>,
+    tree: PyRef<'_, Tree>,
+    pose: &Bound<'py, PyAny>,
+    origins: PyReadonlyArray2<'py, f64>,
+    directions: PyReadonlyArray2<'py, f64>,
+    t_max: f64,
+    orthonormalize: bool,
+    threads: Option<i64>,
+) -> PyResult<(
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+)> {
+    let file = tree.file()?;
+    let pose = single_pose("pose", pose, orthonormalize)?;
+    let rays = ray_rows(&origins, &directions)?;
+    let answers = detached(py, threads, || {
+        all_ray_hits(&file, &pose, &rays, t_max).map_err(Failure::from)
+    })?;
+    let m = answers.iter().map(|a| a.hits.len()).sum();
+    let (mut index, mut columns) = (Vec::with_capacity(m), Columns::with_capacity(m));
+    for (i, (ray, answer)) in rays.iter().zip(&answers).enumerate() {
+        for hit in &answer.hits {
+            index.push(i as i64);
+            columns.push(ray, Some(hit));
+        }
+    }
+    let (t, tri, point, bary, normal) = columns.into_arrays(py)?;
+    Ok((PyArray1::from_vec(py, index), t, tri, point, bary, normal))
+}
+
+/// The rays of (N, 3) origin and direction rows.
+fn ray_rows(
+    origins: &PyReadonlyArray2<'_, f64>,
+    directions: &PyReadonlyArray2<'_, f64>,
+) -> Result<Vec<Ray>, Failure> {
     let (o, d) = (origins.as_array(), directions.as_array());
     if o.ncols() != 3 || d.ncols() != 3 || o.nrows() != d.nrows() {
         return Err(Failure::new(
@@ -44,66 +120,76 @@ pub fn _ray<'py>(
                 o.shape(),
                 d.shape()
             ),
-        )
-        .into());
+        ));
     }
-    let rays: Vec<Ray> = o
-        .rows()
+    Ok(o.rows()
         .into_iter()
         .zip(d.rows())
         .map(|(o, d)| Ray {
             origin: [o[0], o[1], o[2]],
             direction: [d[0], d[1], d[2]],
         })
-        .collect();
-    let mode = match mode {
-        "closest" => Some(RayMode::Closest),
-        "any" => Some(RayMode::Any),
-        "all" => None,
-        other => {
-            return Err(Failure::new(
-                Kind::Option,
-                format!("mode must be \"closest\", \"any\" or \"all\", got {other:?}"),
-            )
-            .into())
+        .collect())
+}
+
+/// Hits as flat columns: `t`, `tri`, and the rows of `point`, `barycentric` and `normal`
+/// (inf, -1 and NaN for a miss).
+struct Columns {
+    t: Vec<f64>,
+    tri: Vec<i64>,
+    point: Vec<f64>,
+    bary: Vec<f64>,
+    normal: Vec<f64>,
+}
+
+/// The columns as NumPy arrays: (n,), (n,) and three (n, 3).
+type Arrays<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
+
+impl Columns {
+    fn with_capacity(n: usize) -> Columns {
+        Columns {
+            t: Vec::with_capacity(n),
+            tri: Vec::with_capacity(n),
+            point: Vec::with_capacity(3 * n),
+            bary: Vec::with_capacity(3 * n),
+            normal: Vec::with_capacity(3 * n),
         }
-    };
-    // The hits with their rays' indices, in ray order (no vector per ray: for one hit
-    // per ray, those allocations would cost as much as the rays).
-    let hits: Vec<(usize, RayHit)> = detached(py, threads, || -> Result<_, Failure> {
-        Ok(match mode {
-            Some(mode) => cast_rays(&file, &pose, &rays, &RayOptions { mode, t_max })?
-                .into_iter()
-                .enumerate()
-                .filter_map(|(i, r)| Some((i, r.hit?)))
-                .collect(),
-            None => all_ray_hits(&file, &pose, &rays, t_max)?
-                .into_iter()
-                .enumerate()
-                .flat_map(|(i, r)| r.hits.into_iter().map(move |h| (i, h)))
-                .collect(),
-        })
-    })?;
-    let m = hits.len();
-    let (mut ray, mut t, mut tri, mut bary, mut normal) = (
-        Vec::with_capacity(m),
-        Vec::with_capacity(m),
-        Vec::with_capacity(m),
-        Vec::with_capacity(3 * m),
-        Vec::with_capacity(3 * m),
-    );
-    for (index, h) in hits {
-        ray.push(index as i64);
-        t.push(h.t);
-        tri.push(i64::from(h.triangle));
-        bary.extend(h.barycentric);
-        normal.extend(h.normal);
     }
-    Ok((
-        PyArray1::from_vec(py, ray),
-        PyArray1::from_vec(py, t),
-        PyArray1::from_vec(py, tri),
-        PyArray1::from_vec(py, bary).reshape([m, 3])?,
-        PyArray1::from_vec(py, normal).reshape([m, 3])?,
-    ))
+
+    /// One row: `ray`'s `hit`, or a miss.
+    fn push(&mut self, ray: &Ray, hit: Option<&RayHit>) {
+        match hit {
+            Some(h) => {
+                self.t.push(h.t);
+                self.tri.push(i64::from(h.triangle));
+                self.point.extend(ray.at(h.t));
+                self.bary.extend(h.barycentric);
+                self.normal.extend(h.normal);
+            }
+            None => {
+                self.t.push(f64::INFINITY);
+                self.tri.push(-1);
+                for rows in [&mut self.point, &mut self.bary, &mut self.normal] {
+                    rows.extend([f64::NAN; 3]);
+                }
+            }
+        }
+    }
+
+    fn into_arrays(self, py: Python<'_>) -> PyResult<Arrays<'_>> {
+        let n = self.t.len();
+        Ok((
+            PyArray1::from_vec(py, self.t),
+            PyArray1::from_vec(py, self.tri),
+            PyArray1::from_vec(py, self.point).reshape([n, 3])?,
+            PyArray1::from_vec(py, self.bary).reshape([n, 3])?,
+            PyArray1::from_vec(py, self.normal).reshape([n, 3])?,
+        ))
+    }
 }
