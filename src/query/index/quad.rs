@@ -36,23 +36,10 @@ impl Quad {
     pub(in crate::query) fn min(self, b: Quad) -> Quad {
         Quad(lanes::min(self.0, b.0))
     }
-    /// Lane by lane, the magnitude.
-    #[inline(always)]
-    pub(in crate::query) fn abs(self) -> Quad {
-        Quad(lanes::abs(self.0))
-    }
     /// Bit `k` set where lane `k` of `self` is at most `b`'s (unset with NaN).
     #[inline(always)]
     pub(in crate::query) fn le_mask(self, b: Quad) -> u32 {
         lanes::le_mask(self.0, b.0)
-    }
-}
-
-impl std::ops::Add for Quad {
-    type Output = Quad;
-    #[inline(always)]
-    fn add(self, b: Quad) -> Quad {
-        Quad(lanes::add(self.0, b.0))
     }
 }
 
@@ -117,19 +104,10 @@ mod lanes {
         both(a, b, |a, b| unsafe { _mm_min_pd(a, b) })
     }
     #[inline(always)]
-    pub fn abs(a: V) -> V {
-        let sign = unsafe { _mm_set1_pd(-0.0) };
-        both(a, (sign, sign), |a, s| unsafe { _mm_andnot_pd(s, a) })
-    }
-    #[inline(always)]
     pub fn le_mask(a: V, b: V) -> u32 {
         let (lo, hi) = both(a, b, |a, b| unsafe { _mm_cmple_pd(a, b) });
         let bits = unsafe { _mm_movemask_pd(lo) | (_mm_movemask_pd(hi) << 2) };
         bits as u32
-    }
-    #[inline(always)]
-    pub fn add(a: V, b: V) -> V {
-        both(a, b, |a, b| unsafe { _mm_add_pd(a, b) })
     }
     #[inline(always)]
     pub fn sub(a: V, b: V) -> V {
@@ -171,20 +149,12 @@ mod lanes {
         zip(a, b, |a, b| if a < b { a } else { b })
     }
     #[inline(always)]
-    pub fn abs(a: V) -> V {
-        a.map(f64::abs)
-    }
-    #[inline(always)]
     pub fn le_mask(a: V, b: V) -> u32 {
         let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a, b);
         u32::from(a0 <= b0)
             | u32::from(a1 <= b1) << 1
             | u32::from(a2 <= b2) << 2
             | u32::from(a3 <= b3) << 3
-    }
-    #[inline(always)]
-    pub fn add(a: V, b: V) -> V {
-        zip(a, b, |a, b| a + b)
     }
     #[inline(always)]
     pub fn sub(a: V, b: V) -> V {
@@ -204,7 +174,6 @@ mod tests {
     fn lanes_keep_their_order_and_the_nan_rule() {
         let a = Quad::widen(&[1.0, -2.0, f32::NAN, 4.0]);
         let b = Quad::widen(&[0.5, 3.0, 7.0, f32::NAN]);
-        assert_eq!(a.abs().to_array()[1], 2.0);
         let max = a.max(b).to_array();
         assert_eq!((max[0], max[1], max[2]), (1.0, 3.0, 7.0));
         assert!(max[3].is_nan());
@@ -213,7 +182,7 @@ mod tests {
         assert!(min[3].is_nan());
         assert_eq!(a.le_mask(b), 0b0010);
         assert_eq!(b.le_mask(a), 0b0001);
-        let sum = (a + Quad::splat(1.0)) * Quad::splat(2.0) - Quad::splat(4.0);
+        let sum = (a - Quad::splat(1.0)) * Quad::splat(2.0);
         assert_eq!(sum.to_array()[0], 0.0);
         assert_eq!(sum.to_array()[3], 6.0);
     }

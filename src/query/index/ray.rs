@@ -16,6 +16,17 @@ pub(in crate::query) struct Slabs {
 /// the inverse and the product each round once.
 const SLAB_ROUNDING: f64 = 4.0 * f64::EPSILON;
 
+/// Factors that widen a computed entry (never negative) and exit by more than their
+/// rounding, in one multiplication: `fl(x (1 ∓ 2r))` moves `x` by at least `2r − ε/2 > r`
+/// of itself. (An exit below 0 shrinks instead, but the ray then misses the box anyway.)
+const SHRINK: f64 = 1.0 - 2.0 * SLAB_ROUNDING;
+const GROW: f64 = 1.0 + 2.0 * SLAB_ROUNDING;
+
+/// The largest exit a slab test keeps: boxes entered beyond it are missed. Grown by
+/// [`GROW`] it stays finite, so an infinite entry (a ray parallel to a slab it lies
+/// outside) never compares below an exit.
+const FARTHEST: f64 = f64::MAX / 2.0;
+
 impl Slabs {
     /// The slabs of the ray `origin + t direction` (finite, direction not zero).
     pub(in crate::query) fn new(origin: [f64; 3], direction: [f64; 3]) -> Slabs {
@@ -47,7 +58,7 @@ impl Slabs {
     #[inline(always)]
     fn entries(&self, node: &IndexNode, reach: f64) -> ([f64; WIDTH], u32) {
         let mut near = Quad::splat(0.0);
-        let mut far = Quad::splat(reach);
+        let mut far = Quad::splat(reach.min(FARTHEST));
         for axis in 0..3 {
             let (o, inverse) = (
                 Quad::splat(self.origin[axis]),
@@ -61,12 +72,10 @@ impl Slabs {
             near = ((Quad::widen(first) - o) * inverse).max(near);
             far = ((Quad::widen(last) - o) * inverse).min(far);
         }
-        // Widened by their rounding once: `x ∓ |x| r` is increasing in `x`, so this is
-        // the largest (smallest) of the widened bounds of the three slabs. (An infinite
-        // entry or exit becomes NaN, and a miss.)
-        let rounding = Quad::splat(SLAB_ROUNDING);
-        let near = near - near.abs() * rounding;
-        let far = far + far.abs() * rounding;
+        // Widened by their rounding once: `x (1 ∓ 2r)` is increasing in `x`, so this is
+        // the largest (smallest) of the widened bounds of the three slabs.
+        let near = near * Quad::splat(SHRINK);
+        let far = far * Quad::splat(GROW);
         (near.to_array(), near.le_mask(far) & node.occupied())
     }
 
@@ -142,7 +151,7 @@ mod tests {
         // In the plane x = 0, parallel to it: on the boundary counts as inside.
         let s = Slabs::new([0.0, 0.5, -1.0], [0.0, 0.0, 1.0]);
         let t = entry(&s, &n, f64::INFINITY).expect("enters");
-        assert!(t <= 1.0 && t > 1.0 - 1e-15);
+        assert!(t <= 1.0 && t > 1.0 - 1e-14);
         let outside = Slabs::new([-1e-300, 0.5, -1.0], [0.0, 0.0, 1.0]);
         assert_eq!(entry(&outside, &n, f64::INFINITY), None);
         // Too short a direction to invert: nothing pruned on its axis.
@@ -155,7 +164,7 @@ mod tests {
         let n = node([1.0, -1.0, -1.0], [2.0, 1.0, 1.0]);
         let s = Slabs::new([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
         let t = entry(&s, &n, f64::INFINITY).expect("enters");
-        assert!(t <= 1.0 && t > 1.0 - 1e-15);
+        assert!(t <= 1.0 && t > 1.0 - 1e-14);
         assert!(entry(&s, &n, 0.5).is_none());
         let behind = Slabs::new([3.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
         assert!(entry(&behind, &n, f64::INFINITY).is_none());
