@@ -5,7 +5,7 @@ use crate::poses::single_pose;
 use crate::queries::detached;
 use crate::tree::Tree;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
-use obbtree::query::{all_ray_hits, cast_rays, Ray, RayHit, RayMode, RayOptions};
+use obbtree::query::{all_ray_hits, cast_rays, QueryError, Ray, RayHit, RayMode, RayOptions};
 use pyo3::prelude::*;
 
 /// The native half of `obbtree.ray` (which documents it) in modes `closest` and `any`:
@@ -47,22 +47,47 @@ pub fn _ray<'py>(
             .into())
         }
     };
-    let answers = detached(py, threads, || {
-        cast_rays(&file, &pose, &rays, &RayOptions { mode, t_max }).map_err(Failure::from)
+    let options = RayOptions { mode, t_max };
+    // Dense columns filled here (scattering hits into them with NumPy took about as long
+    // as casting the rays), a chunk of rays at a time, so that the library's answers are
+    // still in cache when they are copied.
+    let (hit, columns) = detached(py, threads, || {
+        let mut columns = Columns::with_capacity(rays.len());
+        let mut hit = Vec::with_capacity(rays.len());
+        for (k, chunk) in rays.chunks(CHUNK).enumerate() {
+            let answers = cast_rays(&file, &pose, chunk, &options)
+                .map_err(|e| Failure::from(offset_by(e, k * CHUNK)))?;
+            for (ray, answer) in chunk.iter().zip(&answers) {
+                columns.push(ray, answer.hit.as_ref());
+                hit.push(answer.hit.is_some());
+            }
+        }
+        Ok((hit, columns))
     })?;
-    // Dense columns filled in one pass here: scattering hits into them with NumPy took
-    // about as long as casting the rays.
-    let n = answers.len();
-    let mut columns = Columns::with_capacity(n);
-    for (ray, answer) in rays.iter().zip(&answers) {
-        columns.push(ray, answer.hit.as_ref());
-    }
-    let hit = answers
-        .iter()
-        .map(|a| a.hit.is_some())
-        .collect::<Vec<bool>>();
     let (t, tri, point, bary, normal) = columns.into_arrays(py)?;
     Ok((PyArray1::from_vec(py, hit), t, tri, point, bary, normal))
+}
+
+/// Rays per library call in `_ray`: their answers fit in a core's L2 cache.
+const CHUNK: usize = 4096;
+
+/// `error` of a chunk of rays, naming the ray by its index in the whole batch when it
+/// names one.
+fn offset_by(error: QueryError, first: usize) -> QueryError {
+    match error {
+        QueryError::BadInput {
+            what,
+            index,
+            requirement,
+            value,
+        } => QueryError::BadInput {
+            what,
+            index: index + first,
+            requirement,
+            value,
+        },
+        other => other,
+    }
 }
 
 /// The native half of `obbtree.ray` in mode `all`: every hit of every ray, ray by ray and
