@@ -92,31 +92,44 @@ impl Slabs {
         reach: f64,
     ) -> ([Child; WIDTH], usize, usize) {
         let (entries, mask) = self.entries(node, reach);
-        // Each entered child's key with its lane in the two low bits, as an integer: for
-        // keys of at least 0 (an entry is) the bits order as the values do, and clearing
-        // two keeps a lower bound. Missed children sort first, unused.
-        let packed: [u64; WIDTH] = std::array::from_fn(|lane| {
-            if mask >> lane & 1 == 1 {
-                entries[lane].to_bits() & !3 | lane as u64
-            } else {
-                u64::MAX
+        let child = |lane: usize| Child {
+            key: entries[lane],
+            start: node.start[lane],
+            count: node.count[lane],
+        };
+        let mut children = [Child::ROOT; WIDTH];
+        // One or two children entered (most nodes) are placed directly; more are sorted.
+        let first = mask.trailing_zeros() as usize;
+        let rest = mask & mask.wrapping_sub(1);
+        if rest == 0 {
+            if mask != 0 {
+                children[WIDTH - 1] = child(first);
             }
-        });
-        // A sorting network, largest first, of integer minima and maxima: no branch (on
-        // the keys as floats, the compiler branched on every exchange).
-        let mut packed = packed;
-        for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
-            let (a, b) = (packed[i], packed[j]);
-            (packed[i], packed[j]) = (a.max(b), a.min(b));
-        }
-        let children = packed.map(|bits| {
-            let lane = (bits & 3) as usize;
-            Child {
+        } else if rest & rest.wrapping_sub(1) == 0 {
+            let (a, b) = (child(first), child(rest.trailing_zeros() as usize));
+            let (near, far) = if b.key < a.key { (b, a) } else { (a, b) };
+            (children[WIDTH - 2], children[WIDTH - 1]) = (far, near);
+        } else {
+            // Each entered child's key with its lane in the two low bits, as an integer:
+            // for keys of at least 0 (an entry is) the bits order as the values do, and
+            // clearing two keeps a lower bound. Missed children sort first, unused.
+            let mut packed: [u64; WIDTH] = std::array::from_fn(|lane| {
+                if mask >> lane & 1 == 1 {
+                    entries[lane].to_bits() & !3 | lane as u64
+                } else {
+                    u64::MAX
+                }
+            });
+            // A sorting network, largest first, of integer minima and maxima.
+            for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+                let (a, b) = (packed[i], packed[j]);
+                (packed[i], packed[j]) = (a.max(b), a.min(b));
+            }
+            children = packed.map(|bits| Child {
                 key: f64::from_bits(bits & !3),
-                start: node.start[lane],
-                count: node.count[lane],
-            }
-        });
+                ..child((bits & 3) as usize)
+            });
+        }
         let tested = node.occupied().count_ones() as usize;
         (children, mask.count_ones() as usize, tested)
     }
