@@ -4,6 +4,7 @@ use crate::errors::{Failure, Kind};
 use crate::poses::single_pose;
 use crate::queries::detached;
 use crate::tree::Tree;
+use crate::winding::point_rows;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use obbtree::query::{all_ray_hits, cast_rays, QueryError, Ray, RayHit, RayMode, RayOptions};
 use pyo3::prelude::*;
@@ -147,13 +148,10 @@ fn ray_rows(
             ),
         ));
     }
-    Ok(o.rows()
-        .into_iter()
-        .zip(d.rows())
-        .map(|(o, d)| Ray {
-            origin: [o[0], o[1], o[2]],
-            direction: [d[0], d[1], d[2]],
-        })
+    let (o, d) = (point_rows(origins)?, point_rows(directions)?);
+    Ok(o.into_iter()
+        .zip(d)
+        .map(|(origin, direction)| Ray { origin, direction })
         .collect())
 }
 
@@ -188,6 +186,7 @@ impl Columns {
     }
 
     /// One row: `ray`'s `hit`, or a miss.
+    #[inline]
     fn push(&mut self, ray: &Ray, hit: Option<&RayHit>) {
         match hit {
             Some(h) => {

@@ -17,11 +17,19 @@ pub fn point_rows(points: &PyReadonlyArray2<'_, f64>) -> Result<Vec<[f64; 3]>, F
             format!("points must be an (N, 3) array, got (N, {})", view.ncols()),
         ));
     }
-    Ok(view
-        .rows()
-        .into_iter()
-        .map(|r| [r[0], r[1], r[2]])
-        .collect())
+    Ok(match view.as_slice() {
+        // C-contiguous (as the Python side passes them): read as a flat slice, without
+        // the views' per-element index arithmetic.
+        Some(flat) => flat
+            .chunks_exact(3)
+            .filter_map(|row| <[f64; 3]>::try_from(row).ok())
+            .collect(),
+        None => view
+            .rows()
+            .into_iter()
+            .map(|r| [r[0], r[1], r[2]])
+            .collect(),
+    })
 }
 
 /// The options of `beta` and `tolerance` as `obbtree.winding_number` documents them:

@@ -37,7 +37,8 @@ impl RaySpace {
     /// The ray from `origin` along `direction`, or `None` when the direction is zero or
     /// either is not finite.
     pub fn new(origin: &Vector3<f64>, direction: &Vector3<f64>) -> Option<RaySpace> {
-        if !origin.iter().chain(direction.iter()).all(|x| x.is_finite()) {
+        let finite = |v: &Vector3<f64>| v.x.is_finite() && v.y.is_finite() && v.z.is_finite();
+        if !(finite(origin) && finite(direction)) {
             return None;
         }
         let kz = direction.iamax();
