@@ -4,7 +4,7 @@ use crate::errors::Failure;
 use crate::poses::single_pose;
 use crate::queries::detached;
 use crate::tree::Tree;
-use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use obbtree::query::{closest_points, ClosestOptions};
 use pyo3::prelude::*;
 
@@ -40,7 +40,7 @@ pub fn _closest<'py>(
     let n = answers.len();
     let (mut distance, mut point, mut tri, mut feature, mut index) = (
         Vec::with_capacity(n),
-        Vec::with_capacity(n),
+        Vec::with_capacity(3 * n),
         Vec::with_capacity(n),
         Vec::with_capacity(n),
         Vec::with_capacity(n),
@@ -49,7 +49,7 @@ pub fn _closest<'py>(
         match answer.closest {
             Some(c) => {
                 distance.push(c.distance);
-                point.push(c.point.to_vec());
+                point.extend(c.point);
                 tri.push(i64::from(c.triangle));
                 feature.push(match c.feature {
                     obbtree::query::triangle::Feature::Face => 0,
@@ -60,19 +60,14 @@ pub fn _closest<'py>(
             }
             None => {
                 distance.push(f64::INFINITY);
-                point.push(vec![f64::NAN; 3]);
+                point.extend([f64::NAN; 3]);
                 tri.push(-1);
                 feature.push(-1);
                 index.push(-1);
             }
         }
     }
-    let point = if n == 0 {
-        PyArray2::zeros(py, [0, 3], false)
-    } else {
-        PyArray2::from_vec2(py, &point)
-            .map_err(|e| Failure::new(crate::errors::Kind::Base, e.to_string()))?
-    };
+    let point = PyArray1::from_vec(py, point).reshape([n, 3])?;
     Ok((
         PyArray1::from_vec(py, distance),
         point,

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 /// (-1), and three (N, 3) float64 arrays (NaN).
 #[pyfunction]
 #[pyo3(signature = (tree, pose, origins, directions, t_max, mode, orthonormalize, threads))]
-#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 pub fn _ray<'py>(
     py: Python<'py>,
     tree: PyRef<'_, Tree>,
@@ -26,14 +26,7 @@ pub fn _ray<'py>(
     mode: &str,
     orthonormalize: bool,
     threads: Option<i64>,
-) -> PyResult<(
-    Bound<'py, PyArray1<bool>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-)> {
+) -> PyResult<Answers<'py, bool>> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
     let rays = ray_rows(&origins, &directions)?;
@@ -96,7 +89,7 @@ fn offset_by(error: QueryError, first: usize) -> QueryError {
 /// float64, (M,) int64 and three (M, 3) float64 arrays, where M is the number of hits.
 #[pyfunction]
 #[pyo3(signature = (tree, pose, origins, directions, t_max, orthonormalize, threads))]
-#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 pub fn _ray_all<'py>(
     py: Python<'py>,
     tree: PyRef<'_, Tree>,
@@ -106,14 +99,7 @@ pub fn _ray_all<'py>(
     t_max: f64,
     orthonormalize: bool,
     threads: Option<i64>,
-) -> PyResult<(
-    Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-)> {
+) -> PyResult<Answers<'py, i64>> {
     let file = tree.file()?;
     let pose = single_pose("pose", pose, orthonormalize)?;
     let rays = ray_rows(&origins, &directions)?;
@@ -164,6 +150,17 @@ struct Columns {
     bary: Vec<f64>,
     normal: Vec<f64>,
 }
+
+/// What `_ray` and `_ray_all` return: a first (n,) column (which rays hit, or the ray of
+/// each hit), then the [`Arrays`].
+type Answers<'py, First> = (
+    Bound<'py, PyArray1<First>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
 
 /// The columns as NumPy arrays: (n,), (n,) and three (n, 3).
 type Arrays<'py> = (
