@@ -200,12 +200,39 @@ mod tests {
         assert_eq!((count, tested), (3, 3));
         let order: Vec<(u32, u32)> = entered[1..].iter().map(|e| (e.start, e.count)).collect();
         assert_eq!(order, [(10, 0), (30, 0), (20, 3)]);
+        // Their keys are where the ray enters them (x = 4, 2, 0), from just below.
+        for (e, t) in entered[1..].iter().zip([5.0, 3.0, 1.0]) {
+            assert!(e.key <= t && e.key > t - 1e-12, "key {} for {t}", e.key);
+        }
         // Up to t = 4 (x = 3) the farthest box is not entered.
         let (_, count, _) = s.entered(&n, 4.0);
         assert_eq!(count, 2);
         let beside = Slabs::new([-1.0, 2.0, 0.5], [1.0, 0.0, 0.0]);
         assert_eq!(beside.entered(&n, f64::INFINITY).1, 0);
     }
+    #[test]
+    fn one_or_two_children_entered_come_farthest_first_too() {
+        let unit = |x: f64| Bounds {
+            lo: [x, 0.0, 0.0],
+            hi: [x + 1.0, 1.0, 1.0],
+        };
+        // Two boxes entered, in either slot order, and one.
+        for (first, second) in [(0.0, 2.0), (2.0, 0.0)] {
+            let mut n = IndexNode::EMPTY;
+            n.set(1, &unit(first), 10, 1);
+            n.set(3, &unit(second), 20, 2);
+            let s = Slabs::new([-1.0, 0.5, 0.5], [1.0, 0.0, 0.0]);
+            let (entered, count, tested) = s.entered(&n, f64::INFINITY);
+            assert_eq!((count, tested), (2, 2));
+            let near = if first < second { 10 } else { 20 };
+            assert_eq!(entered[WIDTH - 1].start, near);
+            assert_eq!(entered[WIDTH - 2].start, 30 - near);
+            assert!(entered[WIDTH - 1].key < entered[WIDTH - 2].key);
+            let (entered, count, _) = s.entered(&n, 2.5);
+            assert_eq!((count, entered[WIDTH - 1].start), (1, near));
+        }
+    }
+
     /// Where the ray enters and leaves the box, computed in f64 with no widening: within
     /// 4ε of the exact parameters, relative.
     fn slab_interval(o: [f64; 3], d: [f64; 3], lo: [f32; 3], hi: [f32; 3]) -> (f64, f64) {
