@@ -48,7 +48,11 @@ pub fn _ray<'py>(
     let (hit, columns) = detached(py, threads, || {
         let mut columns = Columns::with_capacity(rays.len());
         let mut hit = Vec::with_capacity(rays.len());
-        for (k, chunk) in rays.chunks(CHUNK).enumerate() {
+        // (An empty batch still makes one call, which checks the options.)
+        let chunks = rays
+            .chunks(CHUNK)
+            .chain(rays.is_empty().then_some(&rays[..]));
+        for (k, chunk) in chunks.enumerate() {
             let answers = cast_rays(&file, &pose, chunk, &options)
                 .map_err(|e| Failure::from(offset_by(e, k * CHUNK)))?;
             for (ray, answer) in chunk.iter().zip(&answers) {

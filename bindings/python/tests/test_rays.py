@@ -148,3 +148,17 @@ def test_bad_rays_raise(cow):
         obbtree.ray(cow, np.eye(4), [0, 0, 0], [1, 0, 0], mode="first")
     with pytest.raises(obbtree.PoseError):
         obbtree.ray(cow, np.eye(4) * 2, [0, 0, 0], [1, 0, 0])
+
+
+def test_batches_check_options_when_empty_and_name_a_bad_ray_by_its_index(cow):
+    # Batches are cast in chunks: an empty one still checks its options, and a bad ray
+    # past the first chunk is named by its index in the whole batch.
+    for mode in ("closest", "any", "all"):
+        with pytest.raises(obbtree.OptionError, match="t_max"):
+            obbtree.ray(cow, np.eye(4), np.zeros((0, 3)), np.zeros((0, 3)), t_max=-1.0, mode=mode)
+    empty = obbtree.ray(cow, np.eye(4), np.zeros((0, 3)), np.zeros((0, 3)))
+    assert empty.hit.shape == (0,) and empty.point.shape == (0, 3)
+    directions = np.tile([1.0, 0.0, 0.0], (10_000, 1))
+    directions[9_000] = 0.0
+    with pytest.raises(obbtree.OptionError, match="9000"):
+        obbtree.ray(cow, np.eye(4), np.zeros((10_000, 3)), directions)
