@@ -44,9 +44,9 @@ impl Slabs {
     }
 
     /// Where the ray enters each child box of `node` before parameter `reach` (a lower
-    /// bound of the exact entry), and a bit per slot set where it does and the slot is
-    /// occupied. The bit is set for every box the ray meets at a `t` in `[0, reach]` (of a
-    /// damaged file's NaN boxes, only that it answers).
+    /// bound of the exact entry), and a bit per slot set where it does (empty slots
+    /// included). The bit is set for every box the ray meets at a `t` in `[0, reach]` (of
+    /// a damaged file's NaN boxes, only that it answers).
     ///
     /// An axis the ray is parallel to needs no case of its own: its inverse is infinite,
     /// so a plane on the origin's far side gives an infinite entry or a negative infinite
@@ -75,7 +75,7 @@ impl Slabs {
         // Widened once: `x (1 − 4r)` is increasing in `x`, so this is the largest of the
         // widened entries of the three slabs.
         let near = near * Quad::splat(SHRINK);
-        (near.to_array(), near.le_mask(far) & node.occupied())
+        (near.to_array(), near.le_mask(far))
     }
 
     /// The children of `node` the ray enters before `reach`, farthest first and after
@@ -90,7 +90,9 @@ impl Slabs {
         node: &IndexNode,
         reach: f64,
     ) -> ([Child; WIDTH], usize, usize) {
-        let (entries, mask) = self.entries(node, reach);
+        let occupied = node.occupied();
+        let (entries, entered) = self.entries(node, reach);
+        let mask = entered & occupied;
         let child = |lane: usize| Child {
             key: entries[lane],
             start: node.start[lane],
@@ -129,8 +131,11 @@ impl Slabs {
                 ..child((bits & 3) as usize)
             });
         }
-        let tested = node.occupied().count_ones() as usize;
-        (children, mask.count_ones() as usize, tested)
+        (
+            children,
+            mask.count_ones() as usize,
+            occupied.count_ones() as usize,
+        )
     }
 }
 
@@ -148,6 +153,14 @@ mod tests {
         };
         n.set(0, &b, 0, 1);
         n
+    }
+
+    /// The unit box from `x` along the x axis.
+    fn unit(x: f64) -> Bounds {
+        Bounds {
+            lo: [x, 0.0, 0.0],
+            hi: [x + 1.0, 1.0, 1.0],
+        }
     }
 
     /// Where a ray enters that child, if it does.
@@ -187,10 +200,6 @@ mod tests {
     #[test]
     fn children_come_farthest_first_and_empty_slots_are_not_tested() {
         let mut n = IndexNode::EMPTY;
-        let unit = |x: f64| Bounds {
-            lo: [x, 0.0, 0.0],
-            hi: [x + 1.0, 1.0, 1.0],
-        };
         // Boxes at x = 4, 0 and 2 along +x, and one the ray passes beside.
         n.set(0, &unit(4.0), 10, 0);
         n.set(1, &unit(0.0), 20, 3);
@@ -210,12 +219,9 @@ mod tests {
         let beside = Slabs::new([-1.0, 2.0, 0.5], [1.0, 0.0, 0.0]);
         assert_eq!(beside.entered(&n, f64::INFINITY).1, 0);
     }
+
     #[test]
     fn one_or_two_children_entered_come_farthest_first_too() {
-        let unit = |x: f64| Bounds {
-            lo: [x, 0.0, 0.0],
-            hi: [x + 1.0, 1.0, 1.0],
-        };
         // Two boxes entered, in either slot order, and one.
         for (first, second) in [(0.0, 2.0), (2.0, 0.0)] {
             let mut n = IndexNode::EMPTY;
