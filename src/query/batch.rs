@@ -266,3 +266,39 @@ impl Drop for Pooled<'_> {
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(x: usize) -> Pose {
+        Pose::translation(x as f64, 0.0, 0.0)
+    }
+
+    #[test]
+    fn a_batch_pairs_poses_by_index_and_broadcasts_a_single_one() {
+        let many: Vec<Pose> = (0..3).map(at).collect();
+        let one = [at(7)];
+        let x = |p: &Pose| p.translation_vector().x as usize;
+        let pairs = |batch: PoseBatch<'_>| -> Vec<(usize, usize)> {
+            batch.iter().map(|(a, b)| (x(a), x(b))).collect()
+        };
+        let both = PoseBatch::new(&many, &many).unwrap();
+        assert_eq!((both.len(), both.is_empty()), (3, false));
+        assert_eq!(pairs(both), [(0, 0), (1, 1), (2, 2)]);
+        let a_fixed = PoseBatch::new(&one, &many).unwrap();
+        assert_eq!(a_fixed.len(), 3);
+        assert_eq!(pairs(a_fixed), [(7, 0), (7, 1), (7, 2)]);
+        let b_fixed = PoseBatch::new(&many, &one).unwrap();
+        assert_eq!(pairs(b_fixed), [(0, 7), (1, 7), (2, 7)]);
+        let single = PoseBatch::new(&one, &one).unwrap();
+        assert_eq!((single.len(), single.is_empty()), (1, false));
+        let none = PoseBatch::new(&one, &[]).unwrap();
+        assert_eq!((none.len(), none.is_empty()), (0, true));
+        assert_eq!(none.iter().count(), 0);
+        assert!(matches!(
+            PoseBatch::new(&many[..2], &many),
+            Err(BatchError::Lengths { a: 2, b: 3 })
+        ));
+    }
+}
