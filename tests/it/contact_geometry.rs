@@ -155,6 +155,7 @@ fn a_collision_query_gives_every_contact_its_geometry() {
     for p in r.contacts.iter().flat_map(|c| c.intersection.points()) {
         assert!((0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k]));
     }
+    assert_eq!(r.overlap_area(), 0.0, "no coplanar pairs in a turned pose");
     // Without the option: the same pairs, no geometry.
     let plain = pair
         .collide(&Pose::identity(), &pose_b, &CollideOptions::default())
@@ -220,4 +221,26 @@ fn the_cli_prints_the_geometry() {
         .expect("the column");
     let value: f64 = row[column].parse().expect("a number");
     assert!((value - r.curve_length()).abs() <= 1e-12 * r.curve_length());
+}
+
+/// Two unit cubes, one moved by (0.5, 0.25, 0): their top faces lie in one plane and share
+/// a 0.5 × 0.75 rectangle, as their bottom faces do; the side faces cross.
+#[test]
+fn coplanar_faces_count_in_the_overlap_area() {
+    let file = build(&common::cube(0.5), &BuildOptions::default(), None).expect("builds");
+    let mut pair = PairQuery::new(&file, &file).expect("a pair");
+    let options = CollideOptions {
+        geometry: true,
+        ..CollideOptions::default()
+    };
+    let r = pair
+        .collide(
+            &Pose::identity(),
+            &Pose::translation(0.5, 0.25, 0.0),
+            &options,
+        )
+        .expect("answers");
+    let area = r.overlap_area();
+    assert!((area - 0.75).abs() <= 1e-12, "{area}");
+    assert!(r.curve_length() > 0.0);
 }
