@@ -135,7 +135,7 @@ impl Ord for Pending {
 
 /// Reusable scratch of the traversal: keep one per thread and pass it to every query to
 /// avoid allocating.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct QueryContext {
     /// Pairs waiting in a collision traversal (depth first), or beyond the heap in an
     /// ordered one.
@@ -144,6 +144,20 @@ pub struct QueryContext {
     pub(crate) heap: BinaryHeap<Pending>,
     /// Contacting leaf-ordered face pairs of the running collision query.
     pub(crate) faces: Vec<(u32, u32)>,
+    /// How many pairs `heap` holds before new ones go on `stack`: [`FRONTIER_HEAP`]
+    /// (tests lower it, so that small traversals use the stack too).
+    heap_limit: usize,
+}
+
+impl Default for QueryContext {
+    fn default() -> Self {
+        QueryContext {
+            stack: Vec::new(),
+            heap: BinaryHeap::new(),
+            faces: Vec::new(),
+            heap_limit: FRONTIER_HEAP,
+        }
+    }
 }
 
 /// The pairs waiting in a traversal: a stack (depth first) for unordered policies, a
@@ -181,12 +195,14 @@ const FRONTIER_HEAP: usize = 4096;
 struct Frontier<'c> {
     heap: &'c mut BinaryHeap<Pending>,
     overflow: &'c mut Vec<Pending>,
+    /// The heap's capacity ([`QueryContext`]'s `heap_limit`).
+    limit: usize,
 }
 
 impl Waiting for Frontier<'_> {
     #[inline(always)]
     fn put(&mut self, pending: Pending) {
-        if self.heap.len() < FRONTIER_HEAP {
+        if self.heap.len() < self.limit {
             self.heap.push(pending);
         } else {
             self.overflow.push(pending);
@@ -209,6 +225,15 @@ impl QueryContext {
     /// An empty context; its buffers grow to the largest traversal seen and stay.
     pub fn new() -> QueryContext {
         QueryContext::default()
+    }
+
+    /// An empty context whose ordered traversals keep at most `limit` pairs on the heap.
+    #[cfg(test)]
+    pub(crate) fn with_heap_limit(limit: usize) -> QueryContext {
+        QueryContext {
+            heap_limit: limit,
+            ..QueryContext::default()
+        }
     }
 }
 
@@ -257,6 +282,7 @@ pub(crate) fn traverse<B: BoundingVolume, P: Policy<B>>(
         let mut frontier = Frontier {
             heap: &mut context.heap,
             overflow: &mut context.stack,
+            limit: context.heap_limit,
         };
         frontier.heap.clear();
         frontier.overflow.clear();
@@ -533,4 +559,66 @@ fn push_children<B: BoundingVolume, P: Policy<B>>(
         };
     }
     Ok(dive.map(|(pair, _)| pair))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build::{build, BuildOptions};
+    use crate::generate::Rng;
+    use crate::mesh::TriMesh;
+    use crate::query::{DistanceOptions, PairQuery, SpanOptions};
+
+    /// A heap of one or a few pairs sends nearly every pair of an ordered traversal to the
+    /// overflow stack, taken first: the traversal must still end only where the smallest
+    /// key of all is pruned, with the answers of the full heap.
+    #[test]
+    fn ordered_answers_do_not_depend_on_the_heap_size() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cow.obj");
+        let cow = build(
+            &TriMesh::load(path.as_ref()).unwrap(),
+            &BuildOptions::default(),
+            None,
+        )
+        .unwrap();
+        let mut full = PairQuery::new(&cow, &cow).unwrap();
+        let mut rng = Rng::new(11);
+        let here = Pose::identity();
+        for limit in [1, 2, 16] {
+            let mut small =
+                PairQuery::with_context(&cow, &cow, QueryContext::with_heap_limit(limit)).unwrap();
+            for _ in 0..12 {
+                // Apart by up to about the cow's size, some poses touching.
+                let t = nalgebra::Vector3::from_fn(|_, _| 1.2 * rng.signed());
+                let pose = Pose::new(rng.uniform_rotation(), t).unwrap();
+                for rel_err in [0.0, 0.05] {
+                    let options = DistanceOptions {
+                        rel_err,
+                        ..Default::default()
+                    };
+                    let want = full.distance(&here, &pose, &options).unwrap().distance();
+                    let got = small.distance(&here, &pose, &options).unwrap();
+                    if rel_err == 0.0 {
+                        assert_eq!(got.distance(), want, "heap of {limit}");
+                    } else {
+                        let exact = full
+                            .distance(&here, &pose, &Default::default())
+                            .unwrap()
+                            .distance();
+                        assert!(
+                            got.distance() >= exact && got.distance() <= exact * (1.0 + rel_err),
+                            "heap of {limit}: {} against {exact}",
+                            got.distance()
+                        );
+                    }
+                }
+                let span = |q: &mut PairQuery<'_>| {
+                    q.span(&here, &pose, &SpanOptions::default())
+                        .unwrap()
+                        .span()
+                };
+                assert_eq!(span(&mut small), span(&mut full), "heap of {limit}");
+            }
+        }
+    }
 }
