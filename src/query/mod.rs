@@ -153,3 +153,22 @@ pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), QueryError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_corrupt_tree_is_named_by_its_side() {
+        for (which, name) in [(Side::A, "A"), (Side::B, "B")] {
+            let err = QueryError::CorruptTree {
+                which,
+                what: "a node is reachable along two paths",
+            };
+            assert_eq!(
+                err.to_string(),
+                format!("tree {name} is corrupt: a node is reachable along two paths (run `obbtree verify`)")
+            );
+        }
+    }
+}

@@ -136,6 +136,46 @@ fn batches_equal_one_at_a_time_calls() {
     }
 }
 
+/// Where a batch's queries run: a single pose or one thread on the calling thread (no
+/// hand-off to a pool), `Some(n)` threads on a kept pool of exactly `n`, never the caller.
+#[test]
+fn batches_run_where_their_thread_count_says() {
+    let cube = build(&common::cube(0.5), &BuildOptions::default(), None).unwrap();
+    let poses: Vec<Pose> = (0..64).map(|k| common::turned_pose(k, 0.3)).collect();
+    let caller = std::thread::current().id();
+    // (thread, pool size) of every query of a batch.
+    let run = |poses: &[Pose], threads: Option<usize>| -> Vec<(std::thread::ThreadId, usize)> {
+        let options = BatchOptions {
+            threads: threads.and_then(NonZeroUsize::new),
+        };
+        let both = PoseBatch::new(poses, poses).unwrap();
+        batch(
+            &cube,
+            &cube,
+            both,
+            &options,
+            |pair, a, b| -> Result<_, QueryError> {
+                pair.collide(a, b, &CollideOptions::default())?;
+                Ok((std::thread::current().id(), rayon::current_num_threads()))
+            },
+        )
+        .unwrap()
+        .into_iter()
+        .map(Result::unwrap)
+        .collect()
+    };
+    assert_eq!(run(&poses[..1], None)[0].0, caller, "a single pose");
+    assert!(
+        run(&poses, Some(1)).iter().all(|(t, _)| *t == caller),
+        "one thread"
+    );
+    for n in [2, 3, 2] {
+        let ran = run(&poses, Some(n));
+        assert!(ran.iter().all(|(t, _)| *t != caller), "{n} threads");
+        assert!(ran.iter().all(|(_, size)| *size == n), "{n} threads");
+    }
+}
+
 /// What a batch refuses before any pose, and a query error as its pose's answer.
 #[test]
 fn batch_errors() {
