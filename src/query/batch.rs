@@ -301,4 +301,29 @@ mod tests {
             Err(BatchError::Lengths { a: 2, b: 3 })
         ));
     }
+
+    /// A batch's pair query hands its traversal scratch back to the thread when done, so
+    /// that the next batch on that thread starts with buffers already grown.
+    #[test]
+    fn a_batch_gives_its_scratch_back_to_the_thread() {
+        let cube = crate::generate::cuboid([0.5; 3], [0.0; 3]).unwrap();
+        let cube = crate::build::build(&cube, &Default::default(), None).unwrap();
+        let kept = || SCRATCH.with(|s| s.borrow().as_ref().map(|c| c.stack.capacity()));
+        SCRATCH.with(|s| *s.borrow_mut() = None);
+        assert_eq!(kept(), None);
+        let here = [at(0)];
+        let one_thread = BatchOptions {
+            threads: NonZeroUsize::new(1),
+        };
+        let answers = batch(
+            &cube,
+            &cube,
+            PoseBatch::new(&here, &here).unwrap(),
+            &one_thread,
+            |pair, a, b| pair.collide(a, b, &Default::default()),
+        )
+        .unwrap();
+        assert!(answers[0].as_ref().unwrap().colliding);
+        assert!(kept().is_some_and(|capacity| capacity > 0));
+    }
 }
