@@ -34,6 +34,27 @@ pub(crate) fn max(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])]
 }
 
+/// The lesser of two finite numbers: one compare-and-select, where `f64::min`, which also
+/// orders NaN, takes several instructions. (With a NaN it answers `a`.)
+#[inline(always)]
+pub(crate) fn least(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The greater of two finite numbers, as [`least`] (with a NaN, `a`).
+#[inline(always)]
+pub(crate) fn greatest(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// Componentwise extremes `(min, max)` of `points` (zeros for none).
 pub(crate) fn bounds<'a>(points: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];

@@ -6,7 +6,7 @@
 //! build gives, so the output never depends on scheduling.
 
 use super::{BuildOptions, SphereFit, SPLIT_AXIS_GAIN};
-use crate::arr3::dot;
+use crate::arr3::{self, dot};
 use crate::bv::BoundingVolume;
 use crate::fit::{principal_axes, principal_axes_and_vertices, FaceMoment, FaceMoments, FitMethod};
 use crate::format::NodeRun;
@@ -354,73 +354,84 @@ fn fit_and_split<B: BoundingVolume>(
 /// chosen.
 fn split_axis(positions: &[[f64; 3]], faces: &[[u32; 3]], axes: [[f64; 3]; 3]) -> [f64; 3] {
     let [first, ..] = axes;
-    // A face's corners projected on each axis: their sum (the centroid's, times 3), least
-    // and greatest.
-    let project = |face: &[u32; 3]| {
-        axes.map(|axis| {
-            let [x, y, z] = face.map(|v| positions.get(v as usize).map_or(0.0, |&p| dot(axis, p)));
-            (x + y + z, x.min(y).min(z), x.max(y).max(z))
-        })
-    };
+    // (Faces are checked against the positions before a build; a missing corner would
+    // count as the origin.)
+    let corner = |v: u32| positions.get(v as usize).copied().unwrap_or([0.0; 3]);
     // The mean centroid projected (times 3, as the corners' sums below): one pass of sums.
     let mut corners_sum = [0.0; 3];
     for &v in faces.iter().flatten() {
-        if let Some(p) = positions.get(v as usize) {
-            corners_sum = [
-                corners_sum[0] + p[0],
-                corners_sum[1] + p[1],
-                corners_sum[2] + p[2],
-            ];
-        }
+        let ([sx, sy, sz], [x, y, z]) = (corners_sum, corner(v));
+        corners_sum = [sx + x, sy + y, sz + z];
     }
-    let mean = axes.map(|axis| dot(axis, corners_sum) / faces.len() as f64);
-    // Per candidate axis and side, the extents along each axis, and the side's face count.
-    let mut lo = [[[f64::INFINITY; 3]; 2]; 3];
-    let mut hi = [[[f64::NEG_INFINITY; 3]; 2]; 3];
-    let mut count = [[0usize; 2]; 3];
+    let mean = arr3::map(axes, |axis| dot(axis, corners_sum) / faces.len() as f64);
+    // Per candidate axis, its two sides (below the mean, at or above it).
+    let mut sides = [[SplitSide::EMPTY; 2]; 3];
     for face in faces {
-        let along = project(face);
-        for ((((lo, hi), count), (centroid, _, _)), mean) in lo
-            .iter_mut()
-            .zip(&mut hi)
-            .zip(&mut count)
-            .zip(&along)
-            .zip(&mean)
+        let corners = arr3::map(*face, corner);
+        // On each axis: the corners' sum (the centroid's, times 3), least and greatest.
+        let along = arr3::map(axes, |axis| {
+            let [x, y, z] = arr3::map(corners, |p| dot(axis, p));
+            (
+                x + y + z,
+                arr3::least(arr3::least(x, y), z),
+                arr3::greatest(arr3::greatest(x, y), z),
+            )
+        });
+        let (lo, hi) = (arr3::map(along, |a| a.1), arr3::map(along, |a| a.2));
+        for ([below, above], ((centroid, _, _), mean)) in
+            sides.iter_mut().zip(arr3::zip(along, mean))
         {
-            let side = usize::from(*centroid >= *mean);
-            let (Some(lo), Some(hi), Some(n)) =
-                (lo.get_mut(side), hi.get_mut(side), count.get_mut(side))
-            else {
-                continue;
-            };
-            *n += 1;
-            for ((l, h), (_, least, greatest)) in lo.iter_mut().zip(hi.iter_mut()).zip(&along) {
-                *l = l.min(*least);
-                *h = h.max(*greatest);
-            }
+            let side = if centroid >= mean { above } else { below };
+            side.add(lo, hi);
         }
     }
-    let volume =
-        |lo: &[f64; 3], hi: &[f64; 3]| lo.iter().zip(hi).map(|(l, h)| h - l).product::<f64>();
     let mut best = (f64::INFINITY, first);
-    for (c, axis) in axes.iter().enumerate() {
-        let (Some(lo), Some(hi), Some(count)) = (lo.get(c), hi.get(c), count.get(c)) else {
-            continue;
-        };
-        if count.contains(&0) {
+    for (c, ([below, above], axis)) in arr3::zip(sides, axes).into_iter().enumerate() {
+        if below.count == 0 || above.count == 0 {
             continue;
         }
-        let total: f64 = lo.iter().zip(hi).map(|(l, h)| volume(l, h)).sum();
+        let total = below.volume() + above.volume();
         let merit = if c == 0 {
             total * SPLIT_AXIS_GAIN
         } else {
             total
         };
         if merit < best.0 {
-            best = (merit, *axis);
+            best = (merit, axis);
         }
     }
     best.1
+}
+
+/// One side of a candidate split in [`split_axis`]: the extents of its faces along the
+/// node's axes, and how many there are.
+#[derive(Clone, Copy)]
+struct SplitSide {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    count: usize,
+}
+
+impl SplitSide {
+    const EMPTY: SplitSide = SplitSide {
+        lo: [f64::INFINITY; 3],
+        hi: [f64::NEG_INFINITY; 3],
+        count: 0,
+    };
+
+    /// Adds a face of extents `lo` to `hi`.
+    #[inline(always)]
+    fn add(&mut self, lo: [f64; 3], hi: [f64; 3]) {
+        self.lo = arr3::map(arr3::zip(self.lo, lo), |(a, b)| arr3::least(a, b));
+        self.hi = arr3::map(arr3::zip(self.hi, hi), |(a, b)| arr3::greatest(a, b));
+        self.count += 1;
+    }
+
+    /// The volume of the extents.
+    fn volume(&self) -> f64 {
+        let [x, y, z] = arr3::sub(self.hi, self.lo);
+        x * y * z
+    }
 }
 
 /// Partitions by the centroid projections `proj` (one per face): below the mean to the
