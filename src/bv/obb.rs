@@ -245,28 +245,16 @@ impl Scan {
             l1_max: 0.0,
         };
         for p in points {
-            // Plain comparisons (not `f64::min`, which must also handle NaN): one
-            // instruction each.
             for i in 0..3 {
                 let d = dot(rows[i], *p);
-                scan.lo[i] = if d < scan.lo[i] { d } else { scan.lo[i] };
-                scan.hi[i] = if d > scan.hi[i] { d } else { scan.hi[i] };
+                scan.lo[i] = arr3::least(scan.lo[i], d);
+                scan.hi[i] = arr3::greatest(scan.hi[i], d);
                 if COORDS {
-                    let x = p[i];
-                    scan.coord_lo[i] = if x < scan.coord_lo[i] {
-                        x
-                    } else {
-                        scan.coord_lo[i]
-                    };
-                    scan.coord_hi[i] = if x > scan.coord_hi[i] {
-                        x
-                    } else {
-                        scan.coord_hi[i]
-                    };
+                    scan.coord_lo[i] = arr3::least(scan.coord_lo[i], p[i]);
+                    scan.coord_hi[i] = arr3::greatest(scan.coord_hi[i], p[i]);
                 }
             }
-            let m = l1(p);
-            scan.l1_max = if m > scan.l1_max { m } else { scan.l1_max };
+            scan.l1_max = arr3::greatest(scan.l1_max, l1(p));
         }
         scan
     }

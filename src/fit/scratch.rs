@@ -83,8 +83,8 @@ impl Scratch {
         };
         let (mut lo, mut hi) = (first, first);
         for p in &self.pts {
-            lo = arr3::min(lo, *p);
-            hi = arr3::max(hi, *p);
+            lo = arr3::map(arr3::zip(lo, *p), |(l, x)| arr3::least(l, x));
+            hi = arr3::map(arr3::zip(hi, *p), |(h, x)| arr3::greatest(h, x));
         }
         let sides = arr3::zip(lo, hi);
         let c = arr3::map(sides, |(lo, hi)| 0.5 * (lo + hi));
