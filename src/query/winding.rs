@@ -161,23 +161,44 @@ pub fn winding_numbers(
             // Both made at the file's first such query and kept with it.
             let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
             let clusters = self.model.derived(|| Clusters::of(&index))?;
-            let rule = match self.accuracy {
-                WindingAccuracy::Exact => Rule::Exact,
-                // Bound per unit area: a cluster of area A may err by A times this.
-                WindingAccuracy::Bounded { tolerance } if clusters.area > 0.0 => {
-                    Rule::Rate(tolerance / clusters.area)
-                }
-                WindingAccuracy::Bounded { .. } => Rule::Exact,
-                WindingAccuracy::Beta { beta } => Rule::Beta {
-                    beta,
-                    bound: 1.0 / (PI * (1.0 - 1.0 / beta).powi(5)),
-                },
-            };
             let to_model = Pose::relative(self.pose, &Pose::identity());
-            map_in_space_order(self.points, Vec::new, |stack, p| {
-                let local = to_model.apply(&Vector3::from(*p));
-                descend(&index, &clusters, &local, rule, stack)
-            })
+            // The descent is made for each rule, so that no step asks which rule it follows.
+            fn run(
+                (index, clusters): (&SurfaceIndex, &Clusters),
+                to_model: &Pose,
+                points: &[[f64; 3]],
+                accept: impl Fn(f64, f64, f64, f64) -> Option<f64> + Sync + Send,
+            ) -> Result<Vec<WindingResult>, QueryError> {
+                map_in_space_order(points, Vec::new, |stack, p| {
+                    let local = to_model.apply(&Vector3::from(*p));
+                    descend(index, clusters, &local, &accept, stack)
+                })
+            }
+            let (trees, points) = ((&*index, &*clusters), self.points);
+            let exact = |_, _, _, _| None;
+            match self.accuracy {
+                WindingAccuracy::Exact => run(trees, &to_model, points, exact),
+                // A cluster of area A may err by A times the tolerance per unit area; its
+                // bound is `A r³ / (π (d − r)⁵)`.
+                WindingAccuracy::Bounded { tolerance } if clusters.area > 0.0 => {
+                    let rate = tolerance / clusters.area;
+                    let accept = move |distance: f64, r: f64, area: f64, _| {
+                        let error = area * r * r * r / (PI * (distance - r).powi(5));
+                        (error <= rate * area).then_some(error)
+                    };
+                    run(trees, &to_model, points, accept)
+                }
+                WindingAccuracy::Bounded { .. } => run(trees, &to_model, points, exact),
+                // Beyond β radii, `d − r > d (1 − 1/β)` bounds it from 1/d, which the
+                // expansion needs anyway.
+                WindingAccuracy::Beta { beta } => {
+                    let bound = 1.0 / (PI * (1.0 - 1.0 / beta).powi(5));
+                    let accept = move |distance, r, area, inverse: f64| {
+                        (distance > beta * r).then(|| bound * area * r * r * r * inverse.powi(5))
+                    };
+                    run(trees, &to_model, points, accept)
+                }
+            }
         }
     }
     model.visit(Visit {
@@ -439,18 +460,6 @@ fn solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
     2.0 * numerator.atan2(denominator)
 }
 
-/// Which clusters a descent sums by their moments.
-#[derive(Clone, Copy, Debug)]
-enum Rule {
-    /// None.
-    Exact,
-    /// Those whose error bound is within this many times their area.
-    Rate(f64),
-    /// Those farther than `beta` times their radius; their error bound is `bound` times
-    /// `A r³ / d⁵` (`d` the distance, then `d − r > d (1 − 1/β)`).
-    Beta { beta: f64, bound: f64 },
-}
-
 /// A cluster's moments as its far-field expansion reads them. Seen from a point at `u`
 /// from the centroid (`u = c − p`, `d = |u|`), the cluster's solid angle is to second order
 /// `(N·u + tr spread) / d³ − (3 uᵀ spread u + v·u) / d⁵ + C(u) / d⁷`: the kernel
@@ -544,14 +553,16 @@ impl Expansion {
 }
 
 /// One point's winding number: clusters the rule accepts are summed by their expansions,
-/// leaves' triangles exactly, the rest opened; a node's children are met together.
+/// leaves' triangles exactly, the rest opened; a node's children are met together. The
+/// rule, `accept(d, r, A, 1/d)` for a cluster of radius `r` and area `A` at distance
+/// `d > r`, gives the bound on what its expansion errs by, or `None` to open it.
 // Lanes count to WIDTH, the length of every array they index: no index can fail.
 #[allow(clippy::indexing_slicing)]
 fn descend(
     index: &SurfaceIndex,
     clusters: &Clusters,
     p: &Vector3<f64>,
-    rule: Rule,
+    accept: impl Fn(f64, f64, f64, f64) -> Option<f64>,
     stack: &mut Vec<u32>,
 ) -> Result<WindingResult, QueryError> {
     let missing = || corrupt(Side::A, NodeDefect::Missing);
@@ -579,20 +590,7 @@ fn descend(
             let (distance, r, area) = (distance[lane], reach.radius[lane], reach.area[lane]);
             if distance > r {
                 let inverse = 1.0 / distance;
-                // The bound on what summing by moments errs by, `A r³ / (π (d − r)⁵)`.
-                let error = match rule {
-                    Rule::Exact => None,
-                    Rule::Rate(rate) => {
-                        let gap = distance - r;
-                        let error = area * r * r * r / (PI * gap.powi(5));
-                        (error <= rate * area).then_some(error)
-                    }
-                    // Within that bound; from 1/d, which the expansion needs anyway.
-                    Rule::Beta { beta, bound } => {
-                        (distance > beta * r).then(|| bound * area * r * r * r * inverse.powi(5))
-                    }
-                };
-                if let Some(error) = error {
+                if let Some(error) = accept(distance, r, area, inverse) {
                     sum += reach.expansions[lane].solid_angle(u[lane], inverse);
                     bound += error;
                     work.bv_disjoint += 1;
