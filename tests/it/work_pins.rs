@@ -31,6 +31,10 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("obb all pairs x=0.6", [2245, 3156, 236, 220, 5401]),
     ("obb all pairs x=1", [1671, 2366, 162, 186, 4037]),
     ("obb all pairs x=1.7", [679, 928, 67, 58, 1607]),
+    ("obb all pairs x=0.6 --rule volume", [2248, 3155, 234, 220, 5403]),
+    ("obb all pairs x=0.6 --rule area", [2240, 3153, 237, 220, 5393]),
+    ("obb all pairs x=0.6 --rule a", [5249, 6288, 300, 220, 11537]),
+    ("obb all pairs x=0.6 --rule b", [11107, 12018, 236, 220, 23125]),
     ("obb first contact x=0.6", [0, 23, 0, 1, 23]),
     ("obb first contact x=1", [14, 37, 0, 1, 51]),
     ("obb distance rel_err=0 x=2", [531, 674, 72, 0, 1205]),
@@ -41,6 +45,10 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("aabb all pairs x=0.6", [5305, 9920, 2088, 220, 15225]),
     ("aabb all pairs x=1", [2976, 5313, 983, 186, 8289]),
     ("aabb all pairs x=1.7", [994, 1779, 335, 58, 2773]),
+    ("aabb all pairs x=0.6 --rule volume", [5301, 9916, 2088, 220, 15217]),
+    ("aabb all pairs x=0.6 --rule area", [5295, 9910, 2088, 220, 15205]),
+    ("aabb all pairs x=0.6 --rule a", [10584, 15199, 2088, 220, 25783]),
+    ("aabb all pairs x=0.6 --rule b", [22289, 26904, 2088, 220, 49193]),
     ("aabb first contact x=0.6", [0, 21, 0, 1, 21]),
     ("aabb first contact x=1", [0, 22, 0, 1, 22]),
     ("aabb distance rel_err=0 x=2", [1026, 1935, 455, 0, 2961]),
@@ -51,6 +59,10 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("sphere all pairs x=0.6", [7867, 18320, 5007, 220, 26187]),
     ("sphere all pairs x=1", [4824, 9991, 2398, 186, 14815]),
     ("sphere all pairs x=1.7", [1357, 3214, 871, 58, 4571]),
+    ("sphere all pairs x=0.6 --rule volume", [7867, 18320, 5007, 220, 26187]),
+    ("sphere all pairs x=0.6 --rule area", [7867, 18320, 5007, 220, 26187]),
+    ("sphere all pairs x=0.6 --rule a", [11478, 21677, 4880, 220, 33155]),
+    ("sphere all pairs x=0.6 --rule b", [25559, 34196, 4099, 220, 59755]),
     ("sphere first contact x=0.6", [171, 566, 188, 1, 737]),
     ("sphere first contact x=1", [3, 45, 10, 1, 48]),
     ("sphere distance rel_err=0 x=2", [1408, 3869, 1231, 0, 5277]),
@@ -136,6 +148,24 @@ fn distance(name: String, pose: Pose, rel_err: f64, complete: bool) -> Case {
 /// 1,600 triangles each, B turned by a fixed rotation and moved by `x` along x.
 fn sphere_cases() -> Vec<Case> {
     let mut cases: Vec<Case> = [0.3, 0.6, 1.0, 1.7].into_iter().map(collide).collect();
+    // The other descent rules (§7.3.2), each named as the CLI names it.
+    for rule in &DescentRule::ALL[1..] {
+        let rule = *rule;
+        cases.push(Case {
+            name: format!("all pairs x=0.6 --rule {}", rule.name()),
+            run: Box::new(move |pair| {
+                let pose = common::sliding_pose(0.6, 5);
+                let options = CollideOptions {
+                    rule,
+                    ..CollideOptions::default()
+                };
+                pair.collide(&Pose::identity(), &pose, &options)
+                    .expect("collide")
+                    .work
+            }),
+            complete: true,
+        });
+    }
     for x in [0.6, 1.0] {
         cases.push(first_contact(
             format!("first contact x={x}"),
