@@ -444,3 +444,41 @@ fn warm_started_distances_equal_cold_ones_with_less_work() {
     }
     assert!(warm_work < cold_work, "warm {warm_work} cold {cold_work}");
 }
+
+/// "Closer than t?" is strict, and a pair at exactly `t` does not end the search: one leaf
+/// of B holds, first, a triangle exactly `t` above A's and, second, one at `t / 2`.
+#[test]
+fn a_pair_at_exactly_the_tolerance_does_not_end_the_search() {
+    let triangle = |z: f64| [[0.0, 0.0, z], [1.0, 0.0, z], [0.0, 1.0, z]];
+    let mesh = |zs: &[f64]| {
+        let vertices: Vec<[f64; 3]> = zs.iter().flat_map(|&z| triangle(z)).collect();
+        let faces = (0..zs.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        TriMesh::new(vertices, faces).expect("triangles")
+    };
+    let options = obbtree::build::BuildOptions {
+        leaf_size: 2,
+        ..Default::default()
+    };
+    let a = build(&mesh(&[0.0]), &options, None).expect("builds");
+    let b = build(&mesh(&[0.5, 0.25]), &options, None).expect("builds");
+    let mut pair = PairQuery::new(&a, &b).expect("a pair");
+    let here = Pose::identity();
+    let within = |pair: &mut PairQuery<'_>, tolerance: f64| {
+        let options = ToleranceOptions {
+            tolerance,
+            rule: DescentRule::default(),
+        };
+        pair.within(&here, &here, &options).expect("answers")
+    };
+    let found = within(&mut pair, 0.5);
+    let witness = found
+        .witness
+        .expect("the lower triangle is closer than 0.5");
+    assert_eq!((witness.tri_b, witness.distance), (1, 0.25));
+    assert!(
+        !within(&mut pair, 0.25).closer(),
+        "0.25 is not closer than 0.25"
+    );
+}
