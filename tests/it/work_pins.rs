@@ -98,12 +98,22 @@ struct Case {
     complete: bool,
 }
 
-fn collide(x: f64) -> Case {
+/// All contacts at `x` under `rule`, named with the rule as the CLI names it unless it is
+/// the default.
+fn collide(x: f64, rule: DescentRule) -> Case {
+    let name = if rule == DescentRule::default() {
+        format!("all pairs x={x}")
+    } else {
+        format!("all pairs x={x} --rule {}", rule.name())
+    };
     Case {
-        name: format!("all pairs x={x}"),
+        name,
         run: Box::new(move |pair| {
             let pose = common::sliding_pose(x, 5);
-            let options = CollideOptions::default();
+            let options = CollideOptions {
+                rule,
+                ..CollideOptions::default()
+            };
             pair.collide(&Pose::identity(), &pose, &options)
                 .expect("collide")
                 .work
@@ -147,25 +157,12 @@ fn distance(name: String, pose: Pose, rel_err: f64, complete: bool) -> Case {
 /// The sliding spheres of §5.3.1 at a size a test runs in a moment: radii 1 and 0.8,
 /// 1,600 triangles each, B turned by a fixed rotation and moved by `x` along x.
 fn sphere_cases() -> Vec<Case> {
-    let mut cases: Vec<Case> = [0.3, 0.6, 1.0, 1.7].into_iter().map(collide).collect();
-    // The other descent rules (§7.3.2), each named as the CLI names it.
-    for rule in &DescentRule::ALL[1..] {
-        let rule = *rule;
-        cases.push(Case {
-            name: format!("all pairs x=0.6 --rule {}", rule.name()),
-            run: Box::new(move |pair| {
-                let pose = common::sliding_pose(0.6, 5);
-                let options = CollideOptions {
-                    rule,
-                    ..CollideOptions::default()
-                };
-                pair.collide(&Pose::identity(), &pose, &options)
-                    .expect("collide")
-                    .work
-            }),
-            complete: true,
-        });
-    }
+    let mut cases: Vec<Case> = [0.3, 0.6, 1.0, 1.7]
+        .into_iter()
+        .map(|x| collide(x, DescentRule::default()))
+        .collect();
+    // The other descent rules (§7.3.2).
+    cases.extend(DescentRule::ALL[1..].iter().map(|&rule| collide(0.6, rule)));
     for x in [0.6, 1.0] {
         cases.push(first_contact(
             format!("first contact x={x}"),
