@@ -591,27 +591,23 @@ mod tests {
                 // Apart by up to about the cow's size, some poses touching.
                 let t = nalgebra::Vector3::from_fn(|_, _| 1.2 * rng.signed());
                 let pose = Pose::new(rng.uniform_rotation(), t).unwrap();
-                for rel_err in [0.0, 0.05] {
+                let exact = full
+                    .distance(&here, &pose, &DistanceOptions::default())
+                    .unwrap()
+                    .distance();
+                let mut got = |rel_err| {
                     let options = DistanceOptions {
                         rel_err,
                         ..Default::default()
                     };
-                    let want = full.distance(&here, &pose, &options).unwrap().distance();
-                    let got = small.distance(&here, &pose, &options).unwrap();
-                    if rel_err == 0.0 {
-                        assert_eq!(got.distance(), want, "heap of {limit}");
-                    } else {
-                        let exact = full
-                            .distance(&here, &pose, &Default::default())
-                            .unwrap()
-                            .distance();
-                        assert!(
-                            got.distance() >= exact && got.distance() <= exact * (1.0 + rel_err),
-                            "heap of {limit}: {} against {exact}",
-                            got.distance()
-                        );
-                    }
-                }
+                    small.distance(&here, &pose, &options).unwrap().distance()
+                };
+                assert_eq!(got(0.0), exact, "heap of {limit}");
+                let within = got(0.05);
+                assert!(
+                    within >= exact && within <= exact * 1.05,
+                    "heap of {limit}: {within} against {exact}"
+                );
                 let span = |q: &mut PairQuery<'_>| {
                     q.span(&here, &pose, &SpanOptions::default())
                         .unwrap()
