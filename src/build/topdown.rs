@@ -320,7 +320,7 @@ fn fit_and_split<B: BoundingVolume>(
     let columns: [[f64; 3]; 3] = axes.into();
     let [mut axis, _, _] = columns;
     if ctx.options.split_by_volume {
-        axis = split_axis(ctx.positions, faces, columns);
+        axis = split_axis(ctx.positions, faces, &scratch.vertices, columns);
     }
     let proj = &mut scratch.proj;
     proj.clear();
@@ -352,7 +352,41 @@ fn fit_and_split<B: BoundingVolume>(
 /// node's axes rather than the children's own fits, which cost two fits per candidate and
 /// chose no better on the benchmark meshes.) An axis that would leave a side empty is not
 /// chosen.
-fn split_axis(positions: &[[f64; 3]], faces: &[[u32; 3]], axes: [[f64; 3]; 3]) -> [f64; 3] {
+fn split_axis(
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    vertices: &[u32],
+    axes: [[f64; 3]; 3],
+) -> [f64; 3] {
+    let attempt = PROJECTED.try_with(|cell| {
+        cell.try_borrow_mut()
+            .ok()
+            .map(|mut buffer| split_axis_with(&mut buffer, positions, faces, vertices, axes))
+    });
+    match attempt {
+        Ok(Some(axis)) => axis,
+        // The thread is being torn down: a buffer of this call's own.
+        _ => split_axis_with(&mut Vec::new(), positions, faces, vertices, axes),
+    }
+}
+
+thread_local! {
+    /// Per thread, each vertex's coordinates along a node's axes, indexed by vertex (sized
+    /// by the mesh, so nothing is cleared between nodes: [`split_axis_with`] writes a
+    /// node's vertices before its faces read them).
+    static PROJECTED: std::cell::RefCell<Vec<[f64; 3]>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// [`split_axis`] with the buffer of vertex projections. `vertices` holds every corner of
+/// `faces` (the node's distinct vertices), so each is projected once, not once per face
+/// that uses it.
+fn split_axis_with(
+    projections: &mut Vec<[f64; 3]>,
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+    vertices: &[u32],
+    axes: [[f64; 3]; 3],
+) -> [f64; 3] {
     let [first, ..] = axes;
     // (Faces are checked against the positions before a build; a missing corner would
     // count as the origin.)
@@ -364,25 +398,35 @@ fn split_axis(positions: &[[f64; 3]], faces: &[[u32; 3]], axes: [[f64; 3]; 3]) -
         corners_sum = [sx + x, sy + y, sz + z];
     }
     let mean = arr3::map(axes, |axis| dot(axis, corners_sum) / faces.len() as f64);
+    if projections.len() < positions.len() {
+        projections.resize(positions.len(), [0.0; 3]);
+    }
+    for &v in vertices {
+        if let Some(slot) = projections.get_mut(v as usize) {
+            let p = corner(v);
+            *slot = arr3::map(axes, |axis| dot(axis, p));
+        }
+    }
+    let projected = |v: u32| projections.get(v as usize).copied().unwrap_or([0.0; 3]);
     // Per candidate axis, its two sides (below the mean, at or above it).
     let mut sides = [[SplitSide::EMPTY; 2]; 3];
     for face in faces {
-        let corners = arr3::map(*face, corner);
+        let [p, q, r] = arr3::map(*face, projected);
         // On each axis: the corners' sum (the centroid's, times 3), least and greatest.
-        let along = arr3::map(axes, |axis| {
-            let [x, y, z] = arr3::map(corners, |p| dot(axis, p));
+        let along = arr3::map(arr3::zip(arr3::zip(p, q), r), |((x, y), z)| {
             (
                 x + y + z,
                 arr3::least(arr3::least(x, y), z),
                 arr3::greatest(arr3::greatest(x, y), z),
             )
         });
-        let (lo, hi) = (arr3::map(along, |a| a.1), arr3::map(along, |a| a.2));
+        let [(_, lo0, hi0), (_, lo1, hi1), (_, lo2, hi2)] = along;
+        let extents = [lo0, lo1, lo2, -hi0, -hi1, -hi2];
         for ([below, above], ((centroid, _, _), mean)) in
             sides.iter_mut().zip(arr3::zip(along, mean))
         {
             let side = if centroid >= mean { above } else { below };
-            side.add(lo, hi);
+            side.add(extents);
         }
     }
     let mut best = (f64::INFINITY, first);
@@ -407,30 +451,31 @@ fn split_axis(positions: &[[f64; 3]], faces: &[[u32; 3]], axes: [[f64; 3]; 3]) -
 /// node's axes, and how many there are.
 #[derive(Clone, Copy)]
 struct SplitSide {
-    lo: [f64; 3],
-    hi: [f64; 3],
+    /// The least coordinate along each axis, then the greatest negated (so that both
+    /// grow by taking the least).
+    extents: [f64; 6],
     count: usize,
 }
 
 impl SplitSide {
     const EMPTY: SplitSide = SplitSide {
-        lo: [f64::INFINITY; 3],
-        hi: [f64::NEG_INFINITY; 3],
+        extents: [f64::INFINITY; 6],
         count: 0,
     };
 
-    /// Adds a face of extents `lo` to `hi`.
+    /// Adds a face of `extents` (laid out as [`SplitSide::extents`]).
     #[inline(always)]
-    fn add(&mut self, lo: [f64; 3], hi: [f64; 3]) {
-        self.lo = arr3::map(arr3::zip(self.lo, lo), |(a, b)| arr3::least(a, b));
-        self.hi = arr3::map(arr3::zip(self.hi, hi), |(a, b)| arr3::greatest(a, b));
+    fn add(&mut self, extents: [f64; 6]) {
+        for (e, x) in self.extents.iter_mut().zip(extents) {
+            *e = arr3::least(*e, x);
+        }
         self.count += 1;
     }
 
     /// The volume of the extents.
     fn volume(&self) -> f64 {
-        let [x, y, z] = arr3::sub(self.hi, self.lo);
-        x * y * z
+        let [lo0, lo1, lo2, hi0, hi1, hi2] = self.extents;
+        (-hi0 - lo0) * (-hi1 - lo1) * (-hi2 - lo2)
     }
 }
 
