@@ -482,3 +482,61 @@ fn a_pair_at_exactly_the_tolerance_does_not_end_the_search() {
         "0.25 is not closer than 0.25"
     );
 }
+
+/// A maximum distance excludes pairs at exactly that distance, and a pair found there does
+/// not let the error allowance prune pairs below it: B's first triangle lies exactly
+/// `max_distance` above A's (measured first, as the warm start), its second `1/32` less,
+/// within the 5% allowed, and that one is the answer.
+#[test]
+fn a_pair_at_exactly_the_maximum_distance_is_not_an_answer() {
+    let mesh = |vertices: Vec<[f64; 3]>| {
+        let faces = (0..vertices.len() as u32 / 3)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        TriMesh::new(vertices, faces).expect("triangles")
+    };
+    let options = obbtree::build::BuildOptions::default();
+    let a = build(
+        &mesh(vec![[0.0, 0.0, 0.0], [8.0, 0.0, 0.0], [0.0, 8.0, 0.0]]),
+        &options,
+        None,
+    )
+    .expect("builds");
+    let low = 0.96875;
+    let b = build(
+        &mesh(vec![
+            [0.0, 0.0, 1.0],
+            [0.5, 0.0, 1.0],
+            [0.0, 0.5, 1.0],
+            [3.0, 0.0, low],
+            [4.0, 0.0, low],
+            [3.0, 1.0, low],
+        ]),
+        &options,
+        None,
+    )
+    .expect("builds");
+    let mut pair = PairQuery::new(&a, &b).expect("a pair");
+    let here = Pose::identity();
+    // Moved 7 along x, only B's first triangle is over A's: the warm start is that pair.
+    let moved = Pose::translation(7.0, 0.0, 0.0);
+    let first = pair
+        .distance(&here, &moved, &DistanceOptions::default())
+        .expect("answers");
+    assert_eq!(first.closest.map(|w| (w.tri_b, w.distance)), Some((0, 1.0)));
+    let options = DistanceOptions {
+        rel_err: 0.05,
+        max_distance: 1.0,
+        warm_start: first.warm_start,
+        ..Default::default()
+    };
+    let got = pair.distance(&here, &here, &options).expect("answers");
+    assert_eq!(got.closest.map(|w| (w.tri_b, w.distance)), Some((1, low)));
+    // Without the lower triangle in range, nothing is: 1.0 is not below 1.0.
+    let options = DistanceOptions {
+        max_distance: low,
+        ..options
+    };
+    let got = pair.distance(&here, &here, &options).expect("answers");
+    assert_eq!(got.closest, None);
+}
