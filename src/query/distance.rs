@@ -159,6 +159,9 @@ struct Distance {
     /// Stop as soon as a pair is closer than this (tolerance queries); `-1` otherwise.
     stop_below: f64,
     best: Best,
+    /// [`Distance::threshold`] of `best`, kept with it: every bound asks for it, and the
+    /// best changes a few times a query.
+    prune_at: f64,
 }
 
 impl Distance {
@@ -178,6 +181,7 @@ impl Distance {
                 point_b: d.point_b,
                 faces: Some((fa, fb)),
             };
+            self.prune_at = self.threshold();
             // Nothing can be closer than 0.
             if d.distance == 0.0 || d.distance < self.stop_below {
                 return Flow::Stop;
@@ -219,6 +223,11 @@ impl Distance {
     /// else can): the bound of a pair need not be tightened past it.
     #[inline]
     fn prune_at(&self) -> f64 {
+        self.prune_at
+    }
+
+    /// [`Distance::prune_at`] computed from the best answer.
+    fn threshold(&self) -> f64 {
         if !self.found() {
             return self.max_distance;
         }
@@ -356,6 +365,8 @@ fn policy(rel_err: f64, abs_err: f64, max_distance: f64) -> Result<Distance, Que
             point_b: Vector3::zeros(),
             faces: None,
         },
+        // Nothing found: the maximum alone prunes.
+        prune_at: max_distance,
     })
 }
 
