@@ -540,3 +540,49 @@ fn a_pair_at_exactly_the_maximum_distance_is_not_an_answer() {
     let got = pair.distance(&here, &here, &options).expect("answers");
     assert_eq!(got.closest, None);
 }
+
+/// The allowances and the maximum prune as documented: with `max_distance` 0 no volume
+/// pair is opened, even between models that touch (a pair at 0 is not below 0); with an
+/// absolute error as large as the models, the first triangle pair measured is within it
+/// of every other, and nothing more is measured.
+#[test]
+fn the_maximum_and_the_absolute_error_end_the_search_where_they_say() {
+    let cow = common::cow();
+    let file = build(&cow, &obbtree::build::BuildOptions::default(), None).unwrap();
+    let mut pair = PairQuery::new(&file, &file).unwrap();
+    let here = Pose::identity();
+    let nothing = DistanceOptions {
+        max_distance: 0.0,
+        ..DistanceOptions::default()
+    };
+    let touching = pair.distance(&here, &here, &nothing).unwrap();
+    assert_eq!(touching.closest, None);
+    assert_eq!(touching.work.nodes_visited, 1, "{:?}", touching.work);
+    let apart = Pose::translation(1.5, 0.0, 0.0);
+    let exact = pair
+        .distance(&here, &apart, &DistanceOptions::default())
+        .unwrap();
+    let loose = DistanceOptions {
+        abs_err: 10.0,
+        ..DistanceOptions::default()
+    };
+    let first = pair.distance(&here, &apart, &loose).unwrap();
+    assert_eq!(
+        first.work.tri_separated + first.work.tri_contact,
+        1,
+        "{:?}",
+        first.work
+    );
+    assert!(first.distance() <= exact.distance() + 10.0);
+    assert!(exact.work.tri_separated > 1, "{:?}", exact.work);
+    // An allowance of exactly that first distance prunes everything after it too (every
+    // bound is at least 0); below 1, a product in its place would not.
+    let d1 = first.distance();
+    assert!(d1 < 1.0, "{d1}");
+    let just = DistanceOptions {
+        abs_err: d1,
+        ..DistanceOptions::default()
+    };
+    let again = pair.distance(&here, &apart, &just).unwrap();
+    assert_eq!((again.distance(), again.work), (d1, first.work));
+}
