@@ -558,7 +558,15 @@ fn the_maximum_and_the_absolute_error_end_the_search_where_they_say() {
     let touching = pair.distance(&here, &here, &nothing).unwrap();
     assert_eq!(touching.closest, None);
     assert_eq!(touching.work.nodes_visited, 1, "{:?}", touching.work);
+    // Models further apart than the maximum: their root pair is the only one tested.
     let apart = Pose::translation(1.5, 0.0, 0.0);
+    let near = DistanceOptions {
+        max_distance: 0.01,
+        ..DistanceOptions::default()
+    };
+    let beyond = pair.distance(&here, &apart, &near).unwrap();
+    assert_eq!(beyond.closest, None);
+    assert_eq!(beyond.work.nodes_visited, 1, "{:?}", beyond.work);
     let exact = pair
         .distance(&here, &apart, &DistanceOptions::default())
         .unwrap();
