@@ -443,6 +443,22 @@ fn warm_started_distances_equal_cold_ones_with_less_work() {
         warm_work += warm.work.nodes_visited;
     }
     assert!(warm_work < cold_work, "warm {warm_work} cold {cold_work}");
+    // A warm start that touches ends the query at once, and counts as the one test made.
+    let here = Pose::identity();
+    let touching = pair
+        .distance(&here, &here, &DistanceOptions::default())
+        .unwrap();
+    let again = DistanceOptions {
+        warm_start: touching.warm_start,
+        ..DistanceOptions::default()
+    };
+    let warm = pair.distance(&here, &here, &again).unwrap();
+    assert_eq!(warm.distance(), 0.0);
+    let one_contact = obbtree::query::Work {
+        tri_contact: 1,
+        ..Default::default()
+    };
+    assert_eq!(warm.work, one_contact);
 }
 
 /// "Closer than t?" is strict, and a pair at exactly `t` does not end the search: one leaf
