@@ -377,6 +377,11 @@ fn a_pair_query_refuses_trees_of_different_kinds_and_reuses_its_buffers() {
     .unwrap();
     assert!(PairQuery::new(&obb, &aabb).is_err());
     let mut pair = PairQuery::new(&obb, &obb).unwrap();
+    let shown = format!("{pair:?}");
+    assert!(
+        shown.starts_with("PairQuery") && shown.contains("Obb"),
+        "{shown}"
+    );
     let shifted = Pose::translation(0.2, 0.0, 0.0);
     let mut result = pair
         .collide(&Pose::identity(), &shifted, &CollideOptions::default())
@@ -571,6 +576,11 @@ fn the_maximum_and_the_absolute_error_end_the_search_where_they_say() {
         max_distance: 0.0,
         ..DistanceOptions::default()
     };
+    let negative = DistanceOptions {
+        max_distance: -1.0,
+        ..DistanceOptions::default()
+    };
+    assert!(pair.distance(&here, &here, &negative).is_err());
     let touching = pair.distance(&here, &here, &nothing).unwrap();
     assert_eq!(touching.closest, None);
     assert_eq!(touching.work.nodes_visited, 1, "{:?}", touching.work);
