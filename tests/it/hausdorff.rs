@@ -616,3 +616,31 @@ fn a_warm_start_keeps_the_answer_and_saves_work() {
         assert!(on(&cold, &pose_of_witness) < 1e-12, "{name}");
     }
 }
+
+/// With an error allowed, the one-sided answer with the larger distance need not have the
+/// larger upper bound: a symmetric query proves only as far as the looser of the two. Cow
+/// against a turned cow, 30% allowed: h(A, B) is found larger, h(B, A)'s bound is higher.
+#[test]
+fn a_symmetric_bound_is_the_looser_of_the_two_sides() {
+    let cow = build(
+        &common::cow(),
+        &obbtree::build::BuildOptions::default(),
+        None,
+    )
+    .unwrap();
+    let (pa, pb) = (Pose::identity(), common::turned_pose(2, 0.2));
+    let options = |symmetric| HausdorffOptions {
+        rel_err: 0.3,
+        symmetric,
+        ..HausdorffOptions::default()
+    };
+    let ab = hausdorff(&cow, &pa, &cow, &pb, &options(false)).unwrap();
+    let ba = hausdorff(&cow, &pb, &cow, &pa, &options(false)).unwrap();
+    assert!(ab.distance >= ba.distance && ba.upper_bound > ab.upper_bound);
+    let both = hausdorff(&cow, &pa, &cow, &pb, &options(true)).unwrap();
+    assert_eq!(both.direction, HausdorffDirection::AToB);
+    assert_eq!(
+        (both.distance, both.upper_bound),
+        (ab.distance, ba.upper_bound)
+    );
+}
