@@ -52,3 +52,33 @@ impl std::ops::AddAssign for Work {
         self.nodes_visited += other.nodes_visited;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Work;
+
+    /// The sums and the identity's value on counts that are all different, so that no
+    /// term can stand in for another; the identity is 1 only for complete traversals.
+    #[test]
+    fn the_sums_and_the_identity_add_their_own_terms() {
+        let w = Work {
+            bv_disjoint: 2,
+            bv_overlap: 3,
+            tri_separated: 5,
+            tri_contact: 7,
+            nodes_visited: 11,
+        };
+        assert_eq!((w.bv_tests(), w.tri_tests()), (5, 12));
+        assert_eq!(w.identity_value(), 2 - 3 + 2 * 5 + 2 * 7);
+        let mut twice = w;
+        twice += w;
+        let expected = Work {
+            bv_disjoint: 4,
+            bv_overlap: 6,
+            tri_separated: 10,
+            tri_contact: 14,
+            nodes_visited: 22,
+        };
+        assert_eq!(twice, expected);
+    }
+}
