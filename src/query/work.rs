@@ -57,23 +57,24 @@ impl std::ops::AddAssign for Work {
 mod tests {
     use super::Work;
 
-    /// The sums and the identity's value on counts that are all different, so that no
-    /// term can stand in for another; the identity is 1 only for complete traversals.
+    /// The sums and the identity's value on counts that are all different (and none 0 or
+    /// 2, so that doubling by a product would show), so that no term can stand in for
+    /// another; the identity is 1 only for complete traversals.
     #[test]
     fn the_sums_and_the_identity_add_their_own_terms() {
         let w = Work {
-            bv_disjoint: 2,
+            bv_disjoint: 13,
             bv_overlap: 3,
             tri_separated: 5,
             tri_contact: 7,
             nodes_visited: 11,
         };
-        assert_eq!((w.bv_tests(), w.tri_tests()), (5, 12));
-        assert_eq!(w.identity_value(), 2 - 3 + 2 * 5 + 2 * 7);
+        assert_eq!((w.bv_tests(), w.tri_tests()), (16, 12));
+        assert_eq!(w.identity_value(), 13 - 3 + 2 * 5 + 2 * 7);
         let mut twice = w;
         twice += w;
         let expected = Work {
-            bv_disjoint: 4,
+            bv_disjoint: 26,
             bv_overlap: 6,
             tri_separated: 10,
             tri_contact: 14,
