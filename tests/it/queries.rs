@@ -620,3 +620,17 @@ fn the_maximum_and_the_absolute_error_end_the_search_where_they_say() {
     let again = pair.distance(&here, &apart, &just).unwrap();
     assert_eq!((again.distance(), again.work), (d1, first.work));
 }
+
+/// A span of 0 is an answer: two models that are one and the same point (a triangle whose
+/// corners coincide) are nowhere apart.
+#[test]
+fn two_models_at_one_point_span_zero() {
+    let point = TriMesh::new(vec![[0.25, 0.5, 1.0]; 3], vec![[0, 1, 2]]).expect("a triangle");
+    let file = build(&point, &obbtree::build::BuildOptions::default(), None).expect("builds");
+    let mut pair = PairQuery::new(&file, &file).expect("a pair");
+    let here = Pose::identity();
+    let span = pair
+        .span(&here, &here, &SpanOptions::default())
+        .expect("answers");
+    assert_eq!(span.span(), 0.0);
+}
