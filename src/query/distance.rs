@@ -159,6 +159,8 @@ struct Distance {
     /// Stop as soon as a pair is closer than this (tolerance queries); `-1` otherwise.
     stop_below: f64,
     best: Best,
+    /// A key at or above which [`Policy::keep`] certainly prunes (the maximum distance
+    /// while nothing else can): the bound of a pair need not be tightened past it.
     /// [`Distance::threshold`] of `best`, kept with it: every bound asks for it, and the
     /// best changes a few times a query.
     prune_at: f64,
@@ -219,13 +221,6 @@ impl Distance {
         key * (1.0 + rel_err) < best && key + abs_err < best && key < best * (1.0 - RESOLUTION)
     }
 
-    /// A key at or above which [`Policy::keep`] certainly prunes (the maximum distance while nothing
-    /// else can): the bound of a pair need not be tightened past it.
-    #[inline]
-    fn prune_at(&self) -> f64 {
-        self.prune_at
-    }
-
     /// [`Distance::prune_at`] computed from the best answer.
     fn threshold(&self) -> f64 {
         if !self.found() {
@@ -248,7 +243,7 @@ impl<B: BoundingVolume> Policy<B> for Distance {
 
     #[inline]
     fn key(&self, a: &B, b: &B, b_to_a: &Pose) -> f64 {
-        a.distance_lower_bound_until(b, b_to_a, self.prune_at())
+        a.distance_lower_bound_until(b, b_to_a, self.prune_at)
     }
 
     /// The rank is the mean of the bound and the centres' distance: a bound favours the
@@ -257,7 +252,7 @@ impl<B: BoundingVolume> Policy<B> for Distance {
     /// (measured in docs/results: fewer node pairs, far fewer on touching models).
     #[inline]
     fn key_and_rank(&self, a: &B, b: &B, b_to_a: &Pose) -> (f64, f64) {
-        let (bound, centres) = a.distance_lower_bound_and_centres_until(b, b_to_a, self.prune_at());
+        let (bound, centres) = a.distance_lower_bound_and_centres_until(b, b_to_a, self.prune_at);
         (bound, 0.5 * (bound + centres))
     }
 

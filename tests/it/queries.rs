@@ -466,18 +466,20 @@ fn warm_started_distances_equal_cold_ones_with_less_work() {
     assert_eq!(warm.work, one_contact);
 }
 
+/// A mesh of one triangle per three consecutive `vertices`, none sharing a corner.
+fn separate_triangles(vertices: Vec<[f64; 3]>) -> TriMesh {
+    let faces = (0..vertices.len() as u32 / 3)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    TriMesh::new(vertices, faces).expect("triangles")
+}
+
 /// "Closer than t?" is strict, and a pair at exactly `t` does not end the search: one leaf
 /// of B holds, first, a triangle exactly `t` above A's and, second, one at `t / 2`.
 #[test]
 fn a_pair_at_exactly_the_tolerance_does_not_end_the_search() {
     let triangle = |z: f64| [[0.0, 0.0, z], [1.0, 0.0, z], [0.0, 1.0, z]];
-    let mesh = |zs: &[f64]| {
-        let vertices: Vec<[f64; 3]> = zs.iter().flat_map(|&z| triangle(z)).collect();
-        let faces = (0..zs.len() as u32)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
-        TriMesh::new(vertices, faces).expect("triangles")
-    };
+    let mesh = |zs: &[f64]| separate_triangles(zs.iter().flat_map(|&z| triangle(z)).collect());
     let options = obbtree::build::BuildOptions {
         leaf_size: 2,
         ..Default::default()
@@ -510,12 +512,7 @@ fn a_pair_at_exactly_the_tolerance_does_not_end_the_search() {
 /// within the 5% allowed, and that one is the answer.
 #[test]
 fn a_pair_at_exactly_the_maximum_distance_is_not_an_answer() {
-    let mesh = |vertices: Vec<[f64; 3]>| {
-        let faces = (0..vertices.len() as u32 / 3)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
-        TriMesh::new(vertices, faces).expect("triangles")
-    };
+    let mesh = separate_triangles;
     let options = obbtree::build::BuildOptions::default();
     let a = build(
         &mesh(vec![[0.0, 0.0, 0.0], [8.0, 0.0, 0.0], [0.0, 8.0, 0.0]]),
