@@ -160,9 +160,9 @@ struct Distance {
     stop_below: f64,
     best: Best,
     /// A key at or above which [`Policy::keep`] certainly prunes (the maximum distance
-    /// while nothing else can): the bound of a pair need not be tightened past it.
+    /// while nothing else can): the bound of a pair need not be tightened past it. It is
     /// [`Distance::threshold`] of `best`, kept with it: every bound asks for it, and the
-    /// best changes a few times a query.
+    /// best changes only a few times a query.
     prune_at: f64,
 }
 

@@ -512,17 +512,16 @@ fn a_pair_at_exactly_the_tolerance_does_not_end_the_search() {
 /// within the 5% allowed, and that one is the answer.
 #[test]
 fn a_pair_at_exactly_the_maximum_distance_is_not_an_answer() {
-    let mesh = separate_triangles;
     let options = obbtree::build::BuildOptions::default();
     let a = build(
-        &mesh(vec![[0.0, 0.0, 0.0], [8.0, 0.0, 0.0], [0.0, 8.0, 0.0]]),
+        &separate_triangles(vec![[0.0, 0.0, 0.0], [8.0, 0.0, 0.0], [0.0, 8.0, 0.0]]),
         &options,
         None,
     )
     .expect("builds");
     let low = 0.96875;
     let b = build(
-        &mesh(vec![
+        &separate_triangles(vec![
             [0.0, 0.0, 1.0],
             [0.5, 0.0, 1.0],
             [0.0, 0.5, 1.0],
