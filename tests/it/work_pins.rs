@@ -4,6 +4,10 @@
 //! distance, tolerance and span queries, on sliding spheres (apart, grazing, deep,
 //! concentric) and on the bundled cow against a turned copy.
 //!
+//! The one-model queries (rays and closest points, which descend the surface index rather
+//! than the tree) have a table of their own: a ray's box tests count in D and I, its
+//! triangles in S (missed) and K (hit), and the nodes whose children it tested.
+//!
 //! The answers are checked elsewhere; this test notices what they do not: a box test made
 //! looser or tighter, a lost pruning case, a bound that stops early, a changed descent
 //! order. Every count is deterministic, so a failure means the work changed. A deliberate
@@ -18,9 +22,11 @@ use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
+use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{
-    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, SpanOptions, ToleranceOptions,
+    all_ray_hits, cast_rays, closest_points, ClosestOptions, CollideOptions, DescentRule,
+    DistanceOptions, PairQuery, Pose, Ray, RayMode, RayOptions, SpanOptions, ToleranceOptions,
     Work,
 };
 
@@ -315,5 +321,126 @@ fn the_work_of_fixed_queries_is_pinned_for_every_volume_type() {
             .map(|(name, _)| name.as_str())
             .collect();
         panic!("the work changed in {changed:?}; if that is intended, the new table is:\n{table}");
+    }
+}
+
+/// `(query, [D, I, S, K, nodes visited])`, summed over the rays or points of each query.
+#[rustfmt::skip]
+const ONE_MODEL_PINNED: &[(&str, [u64; 5])] = &[
+    ("rays closest", [11300, 4658, 1153, 321, 15958]),
+    ("rays any", [9717, 4269, 753, 314, 14919]),
+    ("rays closest t_max=0.5", [3267, 836, 13, 3, 4103]),
+    ("rays all hits", [17979, 8645, 2916, 698, 26624]),
+    ("closest points", [15674, 10494, 7370, 0, 26168]),
+    ("closest points max_distance=0.05", [8453, 4788, 2999, 0, 13241]),
+];
+
+/// Rays at the bundled cow (posed): from a sphere around it to points of its bounding
+/// box, as the ray benchmark's incoherent rays, and a grid of rays from one eye.
+fn cow_rays(cow: &TriMesh, pose: &Pose) -> Vec<Ray> {
+    let corners = cow.vertices().iter().map(|p| Vector3::from(*p));
+    let lo = corners
+        .clone()
+        .fold(Vector3::repeat(f64::INFINITY), |m, p| m.inf(&p));
+    let hi = corners.fold(Vector3::repeat(f64::NEG_INFINITY), |m, p| m.sup(&p));
+    let (centre, radius) = ((lo + hi) / 2.0, (hi - lo).norm() / 2.0);
+    let mut rng = Rng::new(11);
+    let mut model = Vec::new();
+    for _ in 0..400 {
+        let on_sphere = Vector3::new(rng.signed(), rng.signed(), rng.signed()).normalize();
+        let origin = centre + on_sphere * (2.0 * radius);
+        let target =
+            lo + (hi - lo).component_mul(&Vector3::new(rng.unit(), rng.unit(), rng.unit()));
+        model.push((origin, target - origin));
+    }
+    let eye = centre + Vector3::new(0.0, 0.0, 3.0 * radius);
+    for i in 0..20 {
+        for j in 0..20 {
+            let (u, v) = (f64::from(i) / 10.0 - 1.0, f64::from(j) / 10.0 - 1.0);
+            let target = centre + Vector3::new(u * radius, v * radius, 0.0);
+            model.push((eye, target - eye));
+        }
+    }
+    model
+        .into_iter()
+        .map(|(origin, direction)| Ray {
+            origin: pose.apply(&origin).into(),
+            direction: (pose.rotation() * direction).into(),
+        })
+        .collect()
+}
+
+fn counts(w: &Work) -> [u64; 5] {
+    [
+        w.bv_disjoint,
+        w.bv_overlap,
+        w.tri_separated,
+        w.tri_contact,
+        w.nodes_visited,
+    ]
+}
+
+fn total<'a>(works: impl Iterator<Item = &'a Work>) -> [u64; 5] {
+    works.fold([0; 5], |mut sum, w| {
+        for (s, c) in sum.iter_mut().zip(counts(w)) {
+            *s += c;
+        }
+        sum
+    })
+}
+
+#[test]
+fn the_work_of_one_model_queries_is_pinned() {
+    let mesh = common::cow();
+    let cow = tree(&mesh, BvKind::Obb);
+    let pose = common::turned_pose(5, 0.7);
+    let rays = cow_rays(&mesh, &pose);
+    let mut actual = Vec::new();
+    for (name, mode, t_max) in [
+        ("rays closest", RayMode::Closest, f64::INFINITY),
+        ("rays any", RayMode::Any, f64::INFINITY),
+        ("rays closest t_max=0.5", RayMode::Closest, 0.5),
+    ] {
+        let options = RayOptions { mode, t_max };
+        let answers = cast_rays(&cow, &pose, &rays, &options).expect("rays");
+        actual.push((name.to_string(), total(answers.iter().map(|a| &a.work))));
+    }
+    let all = all_ray_hits(&cow, &pose, &rays, f64::INFINITY).expect("all hits");
+    actual.push((
+        "rays all hits".to_string(),
+        total(all.iter().map(|a| &a.work)),
+    ));
+    // Points near the surface (the rays' first hits, moved off it), and far.
+    let mut points: Vec<[f64; 3]> = cast_rays(&cow, &pose, &rays, &RayOptions::default())
+        .expect("rays")
+        .iter()
+        .zip(&rays)
+        .filter_map(|(a, ray)| {
+            let hit = a.hit?;
+            Some(std::array::from_fn(|k| {
+                ray.origin[k] + ray.direction[k] * hit.t * 0.98
+            }))
+        })
+        .collect();
+    let mut rng = Rng::new(12);
+    points.extend((0..200).map(|_| [rng.signed() * 3.0, rng.signed() * 3.0, rng.signed() * 3.0]));
+    for (name, max_distance) in [
+        ("closest points", f64::INFINITY),
+        ("closest points max_distance=0.05", 0.05),
+    ] {
+        let options = ClosestOptions { max_distance };
+        let answers = closest_points(&cow, &pose, &points, &options).expect("closest");
+        actual.push((name.to_string(), total(answers.iter().map(|a| &a.work))));
+    }
+    let pinned: Vec<(String, [u64; 5])> = ONE_MODEL_PINNED
+        .iter()
+        .map(|(name, counts)| (name.to_string(), *counts))
+        .collect();
+    if actual != pinned {
+        let table: String = actual
+            .iter()
+            .map(|(name, c)| format!("    (\"{name}\", {c:?}),\n"))
+            .collect();
+        panic!("the work of one-model queries changed; if that is intended, the new table is:\n{table}");
     }
 }
