@@ -276,16 +276,7 @@ fn run(a: &TriMesh, b: &TriMesh, cases: &[Case], out: &mut Vec<(String, [u64; 5]
             if case.complete {
                 assert_eq!(s.identity_value(), 1, "{} {}: {s:?}", bv.name(), case.name);
             }
-            out.push((
-                format!("{} {}", bv.name(), case.name),
-                [
-                    s.bv_disjoint,
-                    s.bv_overlap,
-                    s.tri_separated,
-                    s.tri_contact,
-                    s.nodes_visited,
-                ],
-            ));
+            out.push((format!("{} {}", bv.name(), case.name), counts(&s)));
         }
     }
 }
@@ -306,22 +297,31 @@ fn the_work_of_fixed_queries_is_pinned_for_every_volume_type() {
     );
     let cow = common::cow();
     run(&cow, &cow, &cow_cases(), &mut actual);
-    let pinned: Vec<(String, [u64; 5])> = PINNED
+    assert_pinned(&actual, PINNED);
+}
+
+/// Fails unless `actual` is `pinned`, naming the rows that changed and printing the new
+/// table.
+fn assert_pinned(actual: &[(String, [u64; 5])], pinned: &[(&str, [u64; 5])]) {
+    let pinned: Vec<(String, [u64; 5])> = pinned
         .iter()
         .map(|(name, counts)| (name.to_string(), *counts))
         .collect();
-    if actual != pinned {
-        let table: String = actual
-            .iter()
-            .map(|(name, c)| format!("    (\"{name}\", {c:?}),\n"))
-            .collect();
-        let changed: Vec<&str> = actual
-            .iter()
-            .filter(|row| !pinned.contains(row))
-            .map(|(name, _)| name.as_str())
-            .collect();
-        panic!("the work changed in {changed:?}; if that is intended, the new table is:\n{table}");
-    }
+    assert!(actual == pinned, "{}", changes(actual, &pinned));
+}
+
+/// Which rows of `actual` differ from `pinned`, and the new table.
+fn changes(actual: &[(String, [u64; 5])], pinned: &[(String, [u64; 5])]) -> String {
+    let table: String = actual
+        .iter()
+        .map(|(name, c)| format!("    (\"{name}\", {c:?}),\n"))
+        .collect();
+    let changed: Vec<&str> = actual
+        .iter()
+        .filter(|row| !pinned.contains(row))
+        .map(|(name, _)| name.as_str())
+        .collect();
+    format!("the work changed in {changed:?}; if that is intended, the new table is:\n{table}")
 }
 
 /// `(query, [D, I, S, K, nodes visited])`, summed over the rays or points of each query.
@@ -432,15 +432,5 @@ fn the_work_of_one_model_queries_is_pinned() {
         let answers = closest_points(&cow, &pose, &points, &options).expect("closest");
         actual.push((name.to_string(), total(answers.iter().map(|a| &a.work))));
     }
-    let pinned: Vec<(String, [u64; 5])> = ONE_MODEL_PINNED
-        .iter()
-        .map(|(name, counts)| (name.to_string(), *counts))
-        .collect();
-    if actual != pinned {
-        let table: String = actual
-            .iter()
-            .map(|(name, c)| format!("    (\"{name}\", {c:?}),\n"))
-            .collect();
-        panic!("the work of one-model queries changed; if that is intended, the new table is:\n{table}");
-    }
+    assert_pinned(&actual, ONE_MODEL_PINNED);
 }
