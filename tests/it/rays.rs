@@ -132,6 +132,54 @@ fn closest_any_and_all_hits_match_brute_force_for_every_tree_type() {
     }
 }
 
+/// Ties go to the smallest input id, wherever the tied triangles lie in the index: two
+/// groups of four copies of a triangle (a leaf's worth each) in one plane, overlapping
+/// where the rays meet it, the smaller ids in either group; rays from either side, from
+/// afar (the copies of a group tie) and from a point of the plane (all eight tie at
+/// `t = 0`, where a box entered exactly at the horizon must still be opened).
+#[test]
+fn tied_triangles_go_to_the_smallest_id() {
+    let small = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let large = [[-1.0, -1.0, 0.0], [9.0, -1.0, 0.0], [0.2, 5.0, 0.0]];
+    for first in [small, large] {
+        let second = if first == small { large } else { small };
+        let corners: Vec<[f64; 3]> = [first; 4]
+            .into_iter()
+            .chain([second; 4])
+            .flatten()
+            .collect();
+        let faces = (0..8u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+        let mesh = obbtree::mesh::TriMesh::new(corners, faces).expect("a mesh");
+        for options in common::all_options() {
+            let file = build(&mesh, &options, None).expect("builds");
+            let mut rays = Vec::new();
+            for (x, y) in [(0.2, 0.3), (0.5, 0.25), (0.1, 0.1), (0.3, 0.6)] {
+                for (z, dz) in [(2.0, -1.0), (-3.0, 1.0), (0.0, 1.0), (0.0, -1.0)] {
+                    rays.push(Ray {
+                        origin: [x, y, z],
+                        direction: [0.01, -0.01, dz],
+                    });
+                }
+            }
+            let pose = Pose::identity();
+            let closest = cast_rays(&file, &pose, &rays, &RayOptions::default()).expect("answers");
+            let all = all_ray_hits(&file, &pose, &rays, f64::INFINITY).expect("answers");
+            for (k, ray) in rays.iter().enumerate() {
+                let what = format!("{options:?} ray {ray:?}");
+                let hits: Vec<(f64, u32)> = all[k].hits.iter().map(|h| (h.t, h.triangle)).collect();
+                assert_eq!(hits.len(), 8, "{what}");
+                // Copies of one triangle tie exactly; the two shapes' `t` may differ by a
+                // rounding, except from a point of the plane, where every `t` is 0.
+                let hit = closest[k].hit.map(|h| (h.t, h.triangle));
+                assert_eq!(hit, hits.first().copied(), "{what}");
+                if ray.origin[2] == 0.0 {
+                    assert_eq!(hit, Some((0.0, 0)), "{what}");
+                }
+            }
+        }
+    }
+}
+
 /// Möller–Trumbore's test, for rays clearly inside or outside a triangle: the weights of
 /// corners 1 and 2 and the ray parameter.
 fn moller_trumbore(o: &Vector3<f64>, d: &Vector3<f64>, t: &Tri) -> Option<(f64, f64, f64)> {
