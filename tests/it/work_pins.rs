@@ -4,9 +4,9 @@
 //! distance, tolerance and span queries, on sliding spheres (apart, grazing, deep,
 //! concentric) and on the bundled cow against a turned copy.
 //!
-//! The one-model queries (rays and closest points, which descend the surface index rather
-//! than the tree) have a table of their own: a ray's box tests count in D and I, its
-//! triangles in S (missed) and K (hit), and the nodes whose children it tested.
+//! The one-model queries (rays, closest points and winding numbers, which descend the
+//! surface index rather than the tree) have a table of their own, in the counts each
+//! result type documents.
 //!
 //! The answers are checked elsewhere; this test notices what they do not: a box test made
 //! looser or tighter, a lost pruning case, a bound that stops early, a changed descent
@@ -25,9 +25,9 @@ use obbtree::format::ObbtFile;
 use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{
-    all_ray_hits, cast_rays, closest_points, ClosestOptions, CollideOptions, DescentRule,
-    DistanceOptions, PairQuery, Pose, Ray, RayMode, RayOptions, SpanOptions, ToleranceOptions,
-    Work,
+    all_ray_hits, cast_rays, closest_points, winding_numbers, ClosestOptions, CollideOptions,
+    DescentRule, DistanceOptions, PairQuery, Pose, Ray, RayMode, RayOptions, SpanOptions,
+    ToleranceOptions, WindingAccuracy, WindingOptions, Work,
 };
 
 /// `(query, [D, I, S, K, node pairs visited])`, volume type first in the name.
@@ -331,8 +331,11 @@ const ONE_MODEL_PINNED: &[(&str, [u64; 5])] = &[
     ("rays any", [9717, 4269, 753, 314, 14919]),
     ("rays closest t_max=0.5", [3267, 836, 13, 3, 4103]),
     ("rays all hits", [17979, 8645, 2916, 698, 26624]),
-    ("closest points", [15674, 10494, 7370, 0, 26168]),
-    ("closest points max_distance=0.05", [8453, 4788, 2999, 0, 13241]),
+    ("closest points", [23833, 15324, 10434, 0, 39157]),
+    ("closest points max_distance=0.05", [16612, 9618, 6063, 0, 26230]),
+    ("winding exact", [0, 1256904, 4805712, 0, 3813768]),
+    ("winding beta=2", [61956, 23538, 12045, 0, 91384]),
+    ("winding tolerance=0.001", [438787, 435556, 1034279, 0, 1406478]),
 ];
 
 /// Rays at the bundled cow (posed): from a sphere around it to points of its bounding
@@ -410,16 +413,17 @@ fn the_work_of_one_model_queries_is_pinned() {
         "rays all hits".to_string(),
         total(all.iter().map(|a| &a.work)),
     ));
-    // Points near the surface (the rays' first hits, moved off it), and far.
-    let mut points: Vec<[f64; 3]> = cast_rays(&cow, &pose, &rays, &RayOptions::default())
-        .expect("rays")
+    // Points near the surface (the rays' first hits, moved off it to either side), and far.
+    let hits = cast_rays(&cow, &pose, &rays, &RayOptions::default()).expect("rays");
+    let mut points: Vec<[f64; 3]> = [0.98, 1.02]
         .iter()
-        .zip(&rays)
-        .filter_map(|(a, ray)| {
-            let hit = a.hit?;
-            Some(std::array::from_fn(|k| {
-                ray.origin[k] + ray.direction[k] * hit.t * 0.98
-            }))
+        .flat_map(|along| {
+            hits.iter().zip(&rays).filter_map(move |(a, ray)| {
+                let t = a.hit?.t * along;
+                Some(std::array::from_fn(|k| {
+                    ray.origin[k] + ray.direction[k] * t
+                }))
+            })
         })
         .collect();
     let mut rng = Rng::new(12);
@@ -430,6 +434,18 @@ fn the_work_of_one_model_queries_is_pinned() {
     ] {
         let options = ClosestOptions { max_distance };
         let answers = closest_points(&cow, &pose, &points, &options).expect("closest");
+        actual.push((name.to_string(), total(answers.iter().map(|a| &a.work))));
+    }
+    for (name, accuracy) in [
+        ("winding exact", WindingAccuracy::Exact),
+        ("winding beta=2", WindingAccuracy::default()),
+        (
+            "winding tolerance=0.001",
+            WindingAccuracy::Bounded { tolerance: 1e-3 },
+        ),
+    ] {
+        let options = WindingOptions { accuracy };
+        let answers = winding_numbers(&cow, &pose, &points, &options).expect("winding");
         actual.push((name.to_string(), total(answers.iter().map(|a| &a.work))));
     }
     assert_pinned(&actual, ONE_MODEL_PINNED);
