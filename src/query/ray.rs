@@ -415,12 +415,15 @@ fn descend<B: BoundingVolume, C: Collect>(
     Ok(work)
 }
 
-/// `(v1 − v0) × (v2 − v0)` made unit, zero when it has no direction.
+/// `(v1 − v0) × (v2 − v0)` made unit, zero when it has no direction. Scaled by its
+/// largest component first, so that the sum of squares neither underflows (triangles
+/// below about 1e-81 across) nor overflows (above about 1e77).
 fn unit_normal(t: &Triangle) -> Vector3<f64> {
     let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-    let length = n.norm();
-    if length > 0.0 && length.is_finite() {
-        n / length
+    let largest = n.amax();
+    if largest > 0.0 && largest.is_finite() {
+        let scaled = n / largest;
+        scaled / scaled.norm()
     } else {
         Vector3::zeros()
     }

@@ -440,6 +440,31 @@ fn huge_coordinates_answer_without_nan() {
     assert!(long[0].hit.is_some_and(|h| h.t > 0.0 && h.t < 1e-299));
 }
 
+/// A hit's `t` and normal are right however small or large the triangle (f64 trees, a
+/// cube from 1e-150 to 1e150 across): `t` summed as products of three coordinates would
+/// underflow below about 1e-100 and overflow above about 1e100 (then `t = inf` passed
+/// for a hit of the far face), and the normal's sum of squares would underflow below
+/// about 1e-81 and overflow above about 1e77.
+#[test]
+fn tiny_and_huge_triangles_have_their_t_and_unit_normals() {
+    for exponent in (-150..=150).step_by(10) {
+        let size = 10f64.powi(exponent);
+        let file = common::tree_f64(&common::cube(size));
+        let ray = Ray {
+            origin: [0.1 * size, 0.2 * size, 3.0 * size],
+            direction: [0.0, 0.0, -1.0],
+        };
+        let answer =
+            cast_rays(&file, &Pose::identity(), &[ray], &RayOptions::default()).expect("answers");
+        let hit = answer[0].hit.expect("the cube's top is hit");
+        assert!(
+            (hit.t - 2.0 * size).abs() <= 1e-12 * size,
+            "{size}: {hit:?}"
+        );
+        assert_eq!(hit.normal, [0.0, 0.0, 1.0], "{size}: {hit:?}");
+    }
+}
+
 /// `obbtree ray` prints what the library answers, ray by ray and mode by mode, and
 /// refuses bad input with one line and status 1.
 #[test]

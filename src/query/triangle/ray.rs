@@ -103,14 +103,18 @@ impl RaySpace {
         {
             return None;
         }
-        let t_hit = (u * a[2] + v * b[2] + w * c[2]) / det;
+        // The corners' ray parameters weighted by the barycentric coordinates (in [0, 1]):
+        // weighting by `u`, `v`, `w` first would square the coordinates' magnitude, and
+        // underflow for triangles below about 1e-100 across or overflow above about 1e100.
+        let barycentric = [u / det, v / det, w / det];
+        let t_hit = barycentric[0] * a[2] + barycentric[1] * b[2] + barycentric[2] * c[2];
         // (Also refuses NaN, from coordinates so large that products overflow.)
         if !(t_hit >= 0.0 && t_hit <= t_max) {
             return None;
         }
         Some(RayTriangleHit {
             t: t_hit,
-            barycentric: [u / det, v / det, w / det],
+            barycentric,
         })
     }
 }
