@@ -333,6 +333,7 @@ const ONE_MODEL_PINNED: &[(&str, [u64; 5])] = &[
     ("rays all hits", [17979, 8645, 2916, 698, 26624]),
     ("closest points", [23833, 15324, 10434, 0, 39157]),
     ("closest points max_distance=0.05", [16612, 9618, 6063, 0, 26230]),
+    ("closest points at corners", [20085, 8168, 1743, 1656, 28253]),
     ("winding exact", [0, 1256904, 4805712, 0, 3813768]),
     ("winding beta=2", [61956, 23538, 12045, 0, 91384]),
     ("winding tolerance=0.001", [438787, 435556, 1034279, 0, 1406478]),
@@ -436,6 +437,24 @@ fn the_work_of_one_model_queries_is_pinned() {
         let answers = closest_points(&cow, &pose, &points, &options).expect("closest");
         actual.push((name.to_string(), total(answers.iter().map(|a| &a.work))));
     }
+    // Points on the surface: a corner of every fifth triangle as stored, unposed, so that
+    // their distances are 0.
+    let corners: Vec<[f64; 3]> = common::file_triangles(&cow)
+        .iter()
+        .step_by(5)
+        .map(|(_, [a, _, _])| *a)
+        .collect();
+    let answers = closest_points(
+        &cow,
+        &Pose::identity(),
+        &corners,
+        &ClosestOptions::default(),
+    )
+    .expect("closest");
+    actual.push((
+        "closest points at corners".to_string(),
+        total(answers.iter().map(|a| &a.work)),
+    ));
     for (name, accuracy) in [
         ("winding exact", WindingAccuracy::Exact),
         ("winding beta=2", WindingAccuracy::default()),
