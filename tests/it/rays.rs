@@ -180,6 +180,27 @@ fn tied_triangles_go_to_the_smallest_id() {
     }
 }
 
+/// A model large enough that its index is built on two threads (past `PARALLEL_MIN`
+/// triangles, which the cow is not) answers as brute force: closest and all hits.
+#[test]
+fn a_model_whose_index_is_built_in_parallel_answers_as_brute_force() {
+    let sphere = common::uv_sphere(1.0, 70, 80);
+    let file = build(&sphere, &Default::default(), None).expect("builds");
+    let triangles = common::file_triangles(&file);
+    assert!(triangles.len() > 10_000, "{} triangles", triangles.len());
+    let pose = common::turned_pose(2, 0.4);
+    let rays = rays_at(&triangles, &pose, &mut Rng::new(5));
+    let closest = cast_rays(&file, &pose, &rays, &RayOptions::default()).expect("answers");
+    let all = all_ray_hits(&file, &pose, &rays, f64::INFINITY).expect("answers");
+    for (k, ray) in rays.iter().enumerate() {
+        let brute = brute_hits(&triangles, &pose, ray, f64::INFINITY);
+        let first = closest[k].hit.map(|h| (h.t, h.triangle));
+        assert_eq!(first, brute.first().copied(), "ray {k} {ray:?}");
+        let every: Vec<(f64, u32)> = all[k].hits.iter().map(|h| (h.t, h.triangle)).collect();
+        assert_eq!(every, brute, "ray {k} {ray:?}");
+    }
+}
+
 /// Möller–Trumbore's test, for rays clearly inside or outside a triangle: the weights of
 /// corners 1 and 2 and the ray parameter.
 fn moller_trumbore(o: &Vector3<f64>, d: &Vector3<f64>, t: &Tri) -> Option<(f64, f64, f64)> {
