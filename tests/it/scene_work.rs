@@ -93,3 +93,105 @@ fn counters_of_a_scene_built_for_them() {
     assert_eq!(naive.summary().narrow.total().queries, 50);
     assert_eq!((naive.summary().culled, naive.summary().reused), (0, 0));
 }
+
+/// Each effect runs its query with the rule's options, counted by the same work as a
+/// direct query: first contact (not all pairs) for `contact`; for `distance`, the rule's
+/// relative error and maximum, and from the second frame the previous answer as a warm
+/// start. Two cows overlap (`a`–`b`, contact); `c`–`d` are apart (relative error 0.3), and
+/// so are `e`–`f`, with a maximum of half their distance (their boxes overlap, so the
+/// broad phase keeps them).
+#[test]
+fn each_effect_runs_its_query_with_the_rules_options() {
+    use obbtree::query::{CollideOptions, DistanceOptions, PairQuery};
+    let cow = Arc::new(build(&common::cow(), &BuildOptions::default(), None).unwrap());
+    let poses = [
+        (0.0, 3),
+        (0.3, 4),
+        (10.0, 1),
+        (11.6, 2),
+        (20.0, 5),
+        (20.85, 6),
+    ]
+    .map(|(x, seed)| common::sliding_pose(x, seed));
+
+    // The queries the rules ask for, run directly.
+    let mut pair = PairQuery::new(&cow, &cow).unwrap();
+    let first = CollideOptions {
+        first_contact: true,
+        ..Default::default()
+    };
+    let contact = pair.collide(&poses[0], &poses[1], &first).unwrap();
+    let all = pair
+        .collide(&poses[0], &poses[1], &Default::default())
+        .unwrap();
+    assert!(contact.colliding);
+    assert!(contact.work.bv_tests() < all.work.bv_tests());
+    let with = |rel_err, max_distance, warm_start| DistanceOptions {
+        rel_err,
+        max_distance,
+        warm_start,
+        ..Default::default()
+    };
+    let mut distance = |(i, j): (usize, usize), options: &DistanceOptions| {
+        pair.distance(&poses[i], &poses[j], options).unwrap()
+    };
+    let rel_err = 0.3;
+    let cd = distance((2, 3), &with(rel_err, f64::INFINITY, None));
+    let cd_exact = distance((2, 3), &DistanceOptions::default());
+    assert_ne!(cd.work.bv_tests(), cd_exact.work.bv_tests());
+    let ef_unlimited = distance((4, 5), &DistanceOptions::default());
+    let limit = ef_unlimited.closest.expect("e–f measured").distance / 2.0;
+    let ef = distance((4, 5), &with(0.0, limit, None));
+    assert!(ef.closest.is_none() && limit > 0.0);
+    assert_ne!(ef.work.bv_tests(), ef_unlimited.work.bv_tests());
+
+    let mut builder = SceneBuilder::new();
+    let names = ["a", "b", "c", "d", "e", "f"];
+    let ids: Vec<_> = (names.iter().zip(&poses))
+        .map(|(name, pose)| builder.object(name, cow.clone(), &[], *pose))
+        .collect();
+    builder.rule("*", "*", Effect::None);
+    builder.rule("a", "b", Effect::Contact);
+    let relative = Effect::Distance {
+        rel_err,
+        max_distance: None,
+    };
+    builder.rule("c", "d", relative);
+    let limited = Effect::Distance {
+        rel_err: 0.0,
+        max_distance: Some(limit),
+    };
+    builder.rule("e", "f", limited);
+    let mut scene = builder.build().unwrap();
+    let s = scene.step(&Frame::new()).unwrap().clone();
+    assert_eq!(s.pairs.len(), 2, "a–b and c–d listed");
+    let narrow = scene.summary().narrow;
+    assert_eq!((narrow.contact.queries, narrow.distance.queries), (1, 2));
+    assert_eq!(narrow.contact.box_tests, contact.work.bv_tests());
+    assert_eq!(
+        narrow.distance.box_tests,
+        cd.work.bv_tests() + ef.work.bv_tests()
+    );
+
+    // d moves a little: c–d starts from frame 0's answer.
+    let moved = common::sliding_pose(11.62, 2);
+    let warm = pair
+        .distance(
+            &poses[2],
+            &moved,
+            &with(rel_err, f64::INFINITY, cd.warm_start),
+        )
+        .unwrap();
+    let cold = pair
+        .distance(&poses[2], &moved, &with(rel_err, f64::INFINITY, None))
+        .unwrap();
+    assert_ne!(warm.work.bv_tests(), cold.work.bv_tests());
+    let mut frame = Frame::new();
+    frame.set(ids[3], moved);
+    scene.step(&frame).unwrap();
+    let after = scene.summary().narrow;
+    assert_eq!(
+        after.distance.box_tests - narrow.distance.box_tests,
+        warm.work.bv_tests()
+    );
+}
