@@ -112,8 +112,9 @@ impl Slabs {
             (children[WIDTH - 2], children[WIDTH - 1]) = (far, near);
         } else {
             // Each entered child's key with its lane in the two low bits, as an integer:
-            // for keys of at least 0 (an entry is) the bits order as the values do, and
-            // clearing two keeps a lower bound. Missed children sort first, unused.
+            // for keys of at least 0 (an entry is) the bits order as the values do, to
+            // within those two bits (any order is right; it only steers the work). Missed
+            // children sort first, unused.
             let mut packed: [u64; WIDTH] = std::array::from_fn(|lane| {
                 if mask >> lane & 1 == 1 {
                     entries[lane].to_bits() & !3 | lane as u64
@@ -126,10 +127,7 @@ impl Slabs {
                 let (a, b) = (packed[i], packed[j]);
                 (packed[i], packed[j]) = (a.max(b), a.min(b));
             }
-            children = packed.map(|bits| Child {
-                key: f64::from_bits(bits & !3),
-                ..child((bits & 3) as usize)
-            });
+            children = packed.map(|bits| child((bits & 3) as usize));
         }
         (
             children,
