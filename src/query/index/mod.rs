@@ -457,14 +457,14 @@ fn split(prims: &mut [Prim], parent: &Bounds) -> Option<usize> {
     });
     // (A small group needs no more bins than it has triangles: most groups are small.)
     let bin_count = n.clamp(2, BINS);
+    // 0 (the axis skipped) where the centres do not spread, or a damaged file's extent is
+    // not finite: where the bins' scale is not a finite number.
     let scales: [f64; 3] = std::array::from_fn(|k| {
         let extent =
             centres.hi.get(k).copied().unwrap_or(0.0) - centres.lo.get(k).copied().unwrap_or(0.0);
-        if extent > 0.0 && extent.is_finite() {
-            bin_count as f64 / extent
-        } else {
-            0.0
-        }
+        Some(bin_count as f64 / extent)
+            .filter(|s| s.is_finite())
+            .unwrap_or(0.0)
     });
     // Per axis, the bins' counts and boxes, made in one pass over the prims.
     let mut bins = [[(0usize, Bounds::EMPTY); BINS]; 3];
