@@ -126,15 +126,14 @@ fn random_crossing_segments_match_an_independent_computation() {
 #[test]
 fn a_collision_query_gives_every_contact_its_geometry() {
     let file = build(&common::cow(), &BuildOptions::default(), None).expect("builds");
-    let pose_b = common::turned_pose(5, 0.05);
+    // Both posed, so that the geometry is placed in the world by A's pose too.
+    let (pose_a, pose_b) = (common::sliding_pose(0.02, 7), common::turned_pose(5, 0.05));
     let mut pair = PairQuery::new(&file, &file).expect("a pair");
     let options = CollideOptions {
         geometry: true,
         ..CollideOptions::default()
     };
-    let r = pair
-        .collide(&Pose::identity(), &pose_b, &options)
-        .expect("answers");
+    let r = pair.collide(&pose_a, &pose_b, &options).expect("answers");
     assert!(r.pairs.len() > 50, "{} contacts", r.pairs.len());
     let ids: Vec<(u32, u32)> = r.contacts.iter().map(|c| (c.tri_a, c.tri_b)).collect();
     assert_eq!(ids, r.pairs);
@@ -143,7 +142,7 @@ fn a_collision_query_gives_every_contact_its_geometry() {
         common::file_triangles(&file).into_iter().collect();
     let world = |id: u32, pose: &Pose| tris[&id].map(|p| pose.apply(&Vector3::from(p)).into());
     for c in &r.contacts {
-        let (ta, tb) = (world(c.tri_a, &Pose::identity()), world(c.tri_b, &pose_b));
+        let (ta, tb) = (world(c.tri_a, &pose_a), world(c.tri_b, &pose_b));
         for p in c.intersection.points() {
             let off = point_triangle_distance(p, &ta).max(point_triangle_distance(p, &tb));
             assert!(off <= 1e-12, "{c:?}: {off}");
@@ -158,7 +157,7 @@ fn a_collision_query_gives_every_contact_its_geometry() {
     assert_eq!(r.overlap_area(), 0.0, "no coplanar pairs in a turned pose");
     // Without the option: the same pairs, no geometry.
     let plain = pair
-        .collide(&Pose::identity(), &pose_b, &CollideOptions::default())
+        .collide(&pose_a, &pose_b, &CollideOptions::default())
         .expect("answers");
     assert_eq!(plain.pairs, r.pairs);
     assert!(plain.contacts.is_empty() && plain.contact_bounds().is_none());
