@@ -462,9 +462,12 @@ fn split(prims: &mut [Prim], parent: &Bounds) -> Option<usize> {
     let scales: [f64; 3] = std::array::from_fn(|k| {
         let extent =
             centres.hi.get(k).copied().unwrap_or(0.0) - centres.lo.get(k).copied().unwrap_or(0.0);
-        Some(bin_count as f64 / extent)
-            .filter(|s| s.is_finite())
-            .unwrap_or(0.0)
+        let scale = bin_count as f64 / extent;
+        if scale.is_finite() {
+            scale
+        } else {
+            0.0
+        }
     });
     // Per axis, the bins' counts and boxes, made in one pass over the prims.
     let mut bins = [[(0usize, Bounds::EMPTY); BINS]; 3];
