@@ -65,7 +65,9 @@ impl Default for WindingAccuracy {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WindingResult {
     /// The generalised winding number: 1 inside a closed outward-facing surface, 0
-    /// outside, between for open surfaces; the point is inside where it is `> 0.5`.
+    /// outside, between for open surfaces; the point is inside where it is `> 0.5`. On
+    /// a closed surface it is the share of directions looking inside (½ on a face, ¼ on
+    /// an edge of a cube), to rounding.
     pub value: f64,
     /// A proven bound on `|value − exact|` from the clusters summed by their moments: 0
     /// for [`WindingAccuracy::Exact`], at most the tolerance for
@@ -477,8 +479,14 @@ fn centre(
 /// The solid angle of triangle `t` seen from the origin, signed by the triangle's
 /// orientation (Van Oosterom and Strackee's formula); 0 when the origin lies on it.
 fn solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
-    let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
     let numerator = a.dot(&b.cross(c));
+    // In the triangle's plane the formula gives ±2π on the triangle (the sign of a zero)
+    // and 0 beside it. 0 on it too is the mean of the two sides' limits, so that a point
+    // on a closed surface gets the share of directions looking inside (½ on a face).
+    if numerator == 0.0 {
+        return 0.0;
+    }
+    let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
     let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
     2.0 * numerator.atan2(denominator)
 }

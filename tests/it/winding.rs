@@ -74,7 +74,15 @@ fn winding_numbers_of_closed_meshes_and_soups_are_known_exactly() {
         (
             "cube",
             cube.clone(),
-            vec![([0.0, 0.0, 0.0], 1.0), ([3.0, 0.2, 0.1], 0.0)],
+            // On the surface: the share of directions that look inside (a face's triangle
+            // adds nothing, not the ±2π of either side).
+            vec![
+                ([0.0, 0.0, 0.0], 1.0),
+                ([3.0, 0.2, 0.1], 0.0),
+                ([1.0, 0.2, 0.1], 0.5),
+                ([1.0, -1.0, 0.3], 0.25),
+                ([-1.0, 1.0, 1.0], 0.125),
+            ],
         ),
         (
             "open cube",
