@@ -77,7 +77,8 @@ pub struct HausdorffWarmStart {
 pub enum HausdorffDirection {
     /// h(A, B): the witness lies on A, its closest point on B.
     AToB,
-    /// h(B, A) (only with [`HausdorffOptions::symmetric`]): the witness lies on B.
+    /// h(B, A) (only with [`HausdorffOptions::symmetric`], where it is larger than h(A, B):
+    /// a tie answers [`HausdorffDirection::AToB`]): the witness lies on B.
     BToA,
 }
 

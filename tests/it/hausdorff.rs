@@ -178,9 +178,11 @@ fn coincident_models_are_zero_apart() {
         &Pose::identity(),
         &options,
     );
+    // Both sides 0: a tie answers A's side.
     assert_eq!(
-        h.map(|h| (h.distance, h.upper_bound)).expect("answers"),
-        (0.0, 0.0)
+        h.map(|h| (h.distance, h.upper_bound, h.direction))
+            .expect("answers"),
+        (0.0, 0.0, HausdorffDirection::AToB)
     );
 }
 
