@@ -467,6 +467,19 @@ fn a_ridge_between_two_faces_is_closed_exactly() {
         "the witness is off the ridge: {exact:?}"
     );
     assert_eq!(exact.work.nodes_visited, 117, "{:?}", exact.work);
+    // A segment (a triangle with a repeated corner, in each place) across the floor line,
+    // off centre: its pieces are halved as segments, the same work wherever the repeated
+    // corner is (split as triangles, a piece's first half would be covered three times
+    // over, and the work rise by half).
+    for face in [[0, 0, 1], [0, 1, 1], [0, 1, 0]] {
+        let ends = vec![[-1.0, 0.2, 1.0], [1.3, 0.2, 1.0]];
+        let segment = TriMesh::new(ends, vec![face]).expect("a segment");
+        let a = build(&segment, &BuildOptions::default(), None).expect("builds");
+        let h = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
+        assert!((h.distance - closed_form).abs() <= 1e-15, "{h:?}");
+        assert!(h.upper_bound - h.distance <= 1e-15, "{h:?}");
+        assert_eq!(h.work.nodes_visited, 33, "{face:?}: {:?}", h.work);
+    }
 }
 
 /// The unit square triangulated along the other diagonal than [`square`]'s, with its
