@@ -202,26 +202,10 @@ fn winding_numbers_with(
             let exact = |_, _, _, _| None;
             match self.accuracy {
                 WindingAccuracy::Exact => run(trees, &to_model, points, exact),
-                // A cluster of area A may err by A times the tolerance per unit area; its
-                // bound is `A r³ / (π (d − r)⁵)`.
-                WindingAccuracy::Bounded { tolerance } if clusters.area > 0.0 => {
-                    let rate = tolerance / clusters.area;
-                    let accept = move |distance: f64, r: f64, area: f64, _| {
-                        let error = area * r * r * r / (PI * (distance - r).powi(5));
-                        (error <= rate * area).then_some(error)
-                    };
-                    run(trees, &to_model, points, accept)
+                WindingAccuracy::Bounded { tolerance } => {
+                    run(trees, &to_model, points, bounded(tolerance, clusters.area))
                 }
-                WindingAccuracy::Bounded { .. } => run(trees, &to_model, points, exact),
-                // Beyond β radii, `d − r > d (1 − 1/β)` bounds it from 1/d, which the
-                // expansion needs anyway.
-                WindingAccuracy::Beta { beta } => {
-                    let bound = 1.0 / (PI * (1.0 - 1.0 / beta).powi(5));
-                    let accept = move |distance, r, area, inverse: f64| {
-                        (distance > beta * r).then(|| bound * area * r * r * r * inverse.powi(5))
-                    };
-                    run(trees, &to_model, points, accept)
-                }
+                WindingAccuracy::Beta { beta } => run(trees, &to_model, points, barill(beta)),
             }
         }
     }
@@ -232,6 +216,31 @@ fn winding_numbers_with(
         accuracy: options.accuracy,
         arithmetic,
     })?
+}
+
+/// The rule of [`WindingAccuracy::Bounded`] for a model of area `model_area`: a cluster of
+/// area `A` may err by `A` times the tolerance per unit area, and its expansion errs by at
+/// most `A r³ / (π (d − r)⁵)`. (A model of no area accepts no cluster: its rate is
+/// infinite, and `∞ · 0` is NaN.)
+fn bounded(
+    tolerance: f64,
+    model_area: f64,
+) -> impl Fn(f64, f64, f64, f64) -> Option<f64> + Sync + Send {
+    let rate = tolerance / model_area;
+    move |distance: f64, r: f64, area: f64, _| {
+        let error = area * r * r * r / (PI * (distance - r).powi(5));
+        (error <= rate * area).then_some(error)
+    }
+}
+
+/// The rule of [`WindingAccuracy::Beta`]: a cluster beyond `beta` radii is accepted, and
+/// there `d − r > d (1 − 1/β)` bounds its error from `1/d`, which the expansion needs
+/// anyway.
+fn barill(beta: f64) -> impl Fn(f64, f64, f64, f64) -> Option<f64> + Sync + Send {
+    let bound = 1.0 / (PI * (1.0 - 1.0 / beta).powi(5));
+    move |distance, r, area, inverse: f64| {
+        (distance > beta * r).then(|| bound * area * r * r * r * inverse.powi(5))
+    }
 }
 
 /// The signed distance of `model`, posed by `pose`, at each of `points` (world frame):
@@ -837,6 +846,33 @@ mod tests {
         let far = Vector3::new(30.0, -20.0, 10.0);
         let angle = Expansion::of(&whole).solid_angle::<Separate>(far.into(), 1.0 / far.norm());
         assert!(angle.abs() < 1e-5, "{angle}");
+    }
+
+    /// Barill's rule bounds a cluster's error by at least the proven bound
+    /// `A r³ / (π (d − r)⁵)`, and by that bound itself just beyond β radii.
+    #[test]
+    fn the_beta_rule_bounds_at_least_the_proven_error() {
+        let proven = bounded(f64::MAX, 1.0);
+        for beta in [1.5, 2.0, 3.0] {
+            let rule = barill(beta);
+            for (r, area) in [(0.5, 3.0), (2.0, 0.25)] {
+                assert_eq!(rule(beta * r, r, area, 1.0 / (beta * r)), None);
+                for stretch in [1.0 + 1e-9, 1.25, 2.0, 8.0] {
+                    let d = beta * r * stretch;
+                    let ours = rule(d, r, area, 1.0 / d).expect("accepted");
+                    let truth = proven(d, r, area, 1.0 / d).expect("accepted");
+                    assert!(
+                        ours >= truth * (1.0 - 1e-12),
+                        "{beta} {r} {d}: {ours} {truth}"
+                    );
+                    if stretch < 1.1 {
+                        assert!(ours <= truth * (1.0 + 1e-6), "{beta} {r}: {ours} {truth}");
+                    }
+                }
+            }
+        }
+        // A model of no area has every cluster summed exactly.
+        assert_eq!(bounded(0.1, 0.0)(10.0, 1.0, 0.0, 0.1), None);
     }
 
     /// Where this CPU has FMA, batches take the fused descent: its answers are the separate
