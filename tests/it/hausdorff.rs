@@ -470,7 +470,7 @@ fn a_ridge_between_two_faces_is_closed_exactly() {
     // A segment (a triangle with a repeated corner, in each place) across the floor line,
     // off centre: its pieces are halved as segments, the same work wherever the repeated
     // corner is (split as triangles, a piece's first half would be covered three times
-    // over, and the work rise by half).
+    // over, at more work in every order).
     for face in [[0, 0, 1], [0, 1, 1], [0, 1, 0]] {
         let ends = vec![[-1.0, 0.2, 1.0], [1.3, 0.2, 1.0]];
         let segment = TriMesh::new(ends, vec![face]).expect("a segment");
