@@ -799,6 +799,29 @@ mod tests {
         assert!(slots > index.node_count() * 2, "{slots} slots");
     }
 
+    /// A cluster of no area (degenerate triangles only) is centred on its corners' mean: its
+    /// radius stays finite, and merging it leaves its parent's moments as they were. (An
+    /// undefined centroid would reach every ancestor through the merge and open them all.)
+    #[test]
+    fn a_cluster_of_no_area_sits_at_its_corners_mean() {
+        let v = Vector3::new;
+        let line = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(2.0, 0.0, 0.0)];
+        let point = [v(3.0, 1.0, 1.0); 3];
+        let flat = of_triangles(&[line, point]);
+        assert_eq!(flat.area, 0.0);
+        assert!((flat.centroid - v(2.0, 0.5, 0.5)).norm() < 1e-15, "{}", flat.centroid);
+        let real = of_triangles(&[[v(0.0, 0.0, 1.0), v(2.0, 0.0, 1.0), v(0.0, 3.0, 1.0)]]);
+        let both = merge(&[real, flat]);
+        assert_eq!(both.area, real.area);
+        assert!((both.centroid - real.centroid).norm() < 1e-15);
+        assert!((both.spread - real.spread).norm() < 1e-15);
+        for (b, r) in both.bend.iter().zip(&real.bend) {
+            assert!((b - r).norm() < 1e-15);
+        }
+        // And a cluster of nothing at all sits at the origin.
+        assert_eq!(centre(Vector3::zeros(), 0.0, std::iter::empty()), Vector3::zeros());
+    }
+
     /// The expansion's folded coefficients give the second-order formula term by term:
     /// `N·u/d³ + tr spread/d³ − 3 uᵀ spread u/d⁵ + ½ (−3 (2 Σᵢ bendᵢ row i + tr bendᵢ)·u/d⁵ +
     /// 15 Σᵢ uᵢ uᵀ bendᵢ u/d⁷)`, and that formula approaches the exact solid angle of a
