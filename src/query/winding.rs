@@ -809,7 +809,11 @@ mod tests {
         let point = [v(3.0, 1.0, 1.0); 3];
         let flat = of_triangles(&[line, point]);
         assert_eq!(flat.area, 0.0);
-        assert!((flat.centroid - v(2.0, 0.5, 0.5)).norm() < 1e-15, "{}", flat.centroid);
+        assert!(
+            (flat.centroid - v(2.0, 0.5, 0.5)).norm() < 1e-15,
+            "{}",
+            flat.centroid
+        );
         let real = of_triangles(&[[v(0.0, 0.0, 1.0), v(2.0, 0.0, 1.0), v(0.0, 3.0, 1.0)]]);
         let both = merge(&[real, flat]);
         assert_eq!(both.area, real.area);
@@ -819,7 +823,10 @@ mod tests {
             assert!((b - r).norm() < 1e-15);
         }
         // And a cluster of nothing at all sits at the origin.
-        assert_eq!(centre(Vector3::zeros(), 0.0, std::iter::empty()), Vector3::zeros());
+        assert_eq!(
+            centre(Vector3::zeros(), 0.0, std::iter::empty()),
+            Vector3::zeros()
+        );
     }
 
     /// The expansion's folded coefficients give the second-order formula term by term:
