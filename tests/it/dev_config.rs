@@ -3,8 +3,9 @@
 //! `.cargo/mutants.toml` is read only by `cargo mutants`, which no other test runs: once it
 //! was committed garbled (a megabyte of its own text repeated) and nothing noticed. Here it
 //! must parse, each examined glob must name files that exist, each test filter must be
-//! `tests::` (the library's unit tests) or a module of this binary, and each exclusion must
-//! read as a mutant's name.
+//! `tests::` (the library's unit tests) or a module of this binary, each exclusion must
+//! read as a mutant's name, and one that names its mutant by line must find its code on
+//! that line (three had gone stale as the code above them grew).
 // Test code: a failure is a failed test.
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
@@ -78,5 +79,88 @@ fn mutants_config_parses_and_names_what_exists() {
             re.contains(" with ") || re.contains("delete field ") || re.contains("delete ! in "),
             "not a mutant's name: {re}"
         );
+    }
+}
+
+/// Where an exclusion names a mutant by line, that line still holds what the mutant
+/// changes: code moved under a line-named exclusion would leave it excluding nothing, or a
+/// mutant nobody looked at.
+#[test]
+fn mutants_exclusions_named_by_line_still_find_their_code() {
+    let text = fs::read_to_string(root().join(".cargo/mutants.toml")).unwrap();
+    let config: MutantsConfig = toml::from_str(&text).unwrap();
+    let mut sources = Vec::new();
+    rust_files(&root().join("src"), &mut sources);
+    let mut checked = 0;
+    for re in &config.exclude_re {
+        let Some(site) = named_site(re) else {
+            continue;
+        };
+        let here = |file: &&std::path::PathBuf| {
+            let source = fs::read_to_string(file).unwrap();
+            let Some(line) = source.lines().nth(site.line - 1) else {
+                return false;
+            };
+            match site.column {
+                Some(c) => line
+                    .chars()
+                    .skip(c - 1)
+                    .collect::<String>()
+                    .starts_with(&site.text),
+                None => line.contains(&site.text),
+            }
+        };
+        assert!(
+            sources
+                .iter()
+                .filter(|f| f.ends_with(&site.path))
+                .any(|f| here(&f)),
+            "{re}: line {} of {} has no `{}` (has the code moved?)",
+            site.line,
+            site.path,
+            site.text
+        );
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} exclusions named by line");
+}
+
+/// A place an exclusion names: the end of a file's path, a line, the column if one is
+/// given, and the text the mutant changes there (the operator replaced or the field
+/// deleted), regex escapes removed.
+struct Site {
+    path: String,
+    line: usize,
+    column: Option<usize>,
+    text: String,
+}
+
+/// The place `re` names, if it names one line (not `\d+` or a range of lines).
+fn named_site(re: &str) -> Option<Site> {
+    let (head, mutant) = re.split_once(": ")?;
+    let mut parts = head.split(':');
+    let (path, line, column) = (parts.next()?, parts.next()?, parts.next()?);
+    let text = match mutant.strip_prefix("replace ") {
+        Some(rest) => rest.split_once(" with ")?.0,
+        None => mutant.strip_prefix("delete field ")?.split_once(' ')?.0,
+    };
+    let unescape = |s: &str| s.replace('\\', "");
+    Some(Site {
+        path: unescape(path),
+        line: line.parse().ok()?,
+        column: column.parse().ok(),
+        text: unescape(text),
+    })
+}
+
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in fs::read_dir(dir).unwrap().flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|x| x == "rs") {
+            out.push(path);
+        }
     }
 }
