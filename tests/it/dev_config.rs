@@ -22,6 +22,12 @@ struct MutantsConfig {
     exclude_re: Vec<String>,
 }
 
+/// `.cargo/mutants.toml`, parsed.
+fn mutants_config() -> MutantsConfig {
+    let text = fs::read_to_string(root().join(".cargo/mutants.toml")).unwrap();
+    toml::from_str(&text).unwrap()
+}
+
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
@@ -41,8 +47,7 @@ fn glob_names_files(glob: &str) -> bool {
 
 #[test]
 fn mutants_config_parses_and_names_what_exists() {
-    let text = fs::read_to_string(root().join(".cargo/mutants.toml")).unwrap();
-    let config: MutantsConfig = toml::from_str(&text).unwrap();
+    let config = mutants_config();
     assert!(!config.examine_globs.is_empty());
     for glob in &config.examine_globs {
         assert!(
@@ -87,24 +92,29 @@ fn mutants_config_parses_and_names_what_exists() {
 /// mutant nobody looked at.
 #[test]
 fn mutants_exclusions_named_by_line_still_find_their_code() {
-    let text = fs::read_to_string(root().join(".cargo/mutants.toml")).unwrap();
-    let config: MutantsConfig = toml::from_str(&text).unwrap();
+    let config = mutants_config();
     let mut sources = Vec::new();
     rust_files(&root().join("src"), &mut sources);
     let mut checked = 0;
     for re in &config.exclude_re {
-        let Some(site) = named_site(re) else {
+        let Some(Site {
+            path,
+            line: number,
+            column,
+            text,
+        }) = named_site(re)
+        else {
             continue;
         };
         // One that names a line but no mutant read here would go unchecked.
-        assert!(site.text.is_some(), "{re}: names a line, but what mutant?");
-        let text = site.text.clone().unwrap();
+        assert!(text.is_some(), "{re}: names a line, but what mutant?");
+        let text = text.unwrap();
         let here = |file: &&std::path::PathBuf| {
             let source = fs::read_to_string(file).unwrap();
-            let Some(line) = source.lines().nth(site.line - 1) else {
+            let Some(line) = source.lines().nth(number - 1) else {
                 return false;
             };
-            match site.column {
+            match column {
                 Some(c) => line
                     .chars()
                     .skip(c - 1)
@@ -116,12 +126,9 @@ fn mutants_exclusions_named_by_line_still_find_their_code() {
         assert!(
             sources
                 .iter()
-                .filter(|f| f.ends_with(&site.path))
+                .filter(|f| f.ends_with(&path))
                 .any(|f| here(&f)),
-            "{re}: line {} of {} has no `{}` (has the code moved?)",
-            site.line,
-            site.path,
-            text
+            "{re}: line {number} of {path} has no `{text}` (has the code moved?)"
         );
         checked += 1;
     }
