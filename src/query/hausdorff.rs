@@ -1016,6 +1016,22 @@ fn farthest(nearest: &[Option<Near>], vertices: &[Vector3<f64>], owner: &[u32]) 
     witness
 }
 
+/// The length of piece that is not split further, for a lower bound `lower` on h and the
+/// measured model's bounding-box diagonal `diagonal` (both world units): the error allowed,
+/// where it lies between [`FINEST`] and [`FLOOR`] of the diagonal, else `FLOOR` of it.
+/// Pieces smaller than the error allowed are within it (a point of a piece is no farther
+/// from B than a corner is plus its distance to that corner), so with an error asked
+/// splitting goes on until the bounds meet it; below `FINEST` of the diagonal (only a
+/// relative error, and h about 0), and for exact answers, it stops at `FLOOR`.
+fn split_floor(options: &HausdorffOptions, lower: f64, diagonal: f64) -> f64 {
+    let allowed = (options.rel_err * lower).max(options.abs_err);
+    if allowed >= FINEST * diagonal {
+        allowed.min(FLOOR * diagonal)
+    } else {
+        FLOOR * diagonal
+    }
+}
+
 fn bound<B: BoundingVolume>(
     tree: &To<'_, '_, B>,
     from: &FromModel,
@@ -1039,18 +1055,7 @@ fn bound<B: BoundingVolume>(
         |(lo, hi), p| (lo.inf(p), hi.sup(p)),
     );
     let diagonal = (hi - lo).norm();
-    // Pieces smaller than the error allowed are within it (a point of a piece is no farther
-    // from B than a corner is plus its distance to that corner), so with an error asked
-    // splitting goes on until the bounds meet it; below `FINEST` of the diagonal (only a
-    // relative error, and h about 0), and for exact answers, it stops at `FLOOR`.
-    let floor = |lower: f64| {
-        let allowed = (options.rel_err * lower).max(options.abs_err);
-        if allowed >= FINEST * diagonal {
-            allowed.min(FLOOR * diagonal)
-        } else {
-            FLOOR * diagonal
-        }
-    };
+    let floor = |lower: f64| split_floor(options, lower, diagonal);
     // Distances between points of this magnitude are only known to a few ulps of it:
     // bounds that close to each other are exact to f64 rounding.
     let rounding = 8.0 * f64::EPSILON * lo.abs().sup(&hi.abs()).max();
@@ -1318,6 +1323,36 @@ fn bound<B: BoundingVolume>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Pieces are split down to the error allowed where it lies between 2⁻²⁴ and 2⁻¹⁶ of
+    /// the diagonal, and to 2⁻¹⁶ of it otherwise: exact answers, allowances above, and
+    /// allowances below (a relative error of an h about 0). A diagonal far from 1 tells
+    /// each fraction from its inverse.
+    #[test]
+    fn pieces_split_to_the_allowance_between_two_fractions_of_the_diagonal() {
+        let d = 1000.0;
+        let absolute = |abs_err| HausdorffOptions {
+            abs_err,
+            ..HausdorffOptions::default()
+        };
+        let floor = FLOOR * d;
+        assert_eq!(split_floor(&absolute(0.0), 5.0, d), floor);
+        for between in [FINEST * d, 1e-6 * d, floor / 2.0] {
+            assert_eq!(split_floor(&absolute(between), 5.0, d), between);
+        }
+        for beyond in [1e-9 * d, FINEST * d / 2.0, floor * 2.0, 0.1 * d] {
+            assert_eq!(split_floor(&absolute(beyond), 5.0, d), floor, "{beyond}");
+        }
+        // A relative error allows that fraction of the lower bound, the larger of the two
+        // allowances counting.
+        let relative = HausdorffOptions {
+            rel_err: 1e-6,
+            abs_err: 1e-6,
+            ..HausdorffOptions::default()
+        };
+        assert_eq!(split_floor(&relative, d, d), 1e-6 * d);
+        assert_eq!(split_floor(&relative, 1.0, d), floor);
+    }
 
     /// The least of the planes at `l`, the function [`interpolated_envelope`] maximises.
     fn least(distances: &[Vector3<f64>], l: &Vector3<f64>) -> f64 {
