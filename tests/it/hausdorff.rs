@@ -186,6 +186,37 @@ fn coincident_models_are_zero_apart() {
     );
 }
 
+/// Coincident copies of a model away from the origin close at the rounding of its
+/// coordinates, for about the work they take at the origin: distances between its points
+/// are known only to a few ulps of those coordinates, so bounds that close that far are
+/// exact, and no piece is split further chasing a gap that is rounding.
+#[test]
+fn coincident_models_away_from_the_origin_close_at_their_rounding() {
+    let cow = common::cow();
+    let moved: Vec<[f64; 3]> = cow
+        .vertices()
+        .iter()
+        .map(|v| [v[0] + 100.0, v[1] - 200.0, v[2] + 300.0])
+        .collect();
+    let away = TriMesh::new(moved, cow.faces().to_vec()).expect("the cow, moved");
+    let [away, near] =
+        [away, cow].map(|mesh| build(&mesh, &BuildOptions::default(), None).expect("builds"));
+    let rounding = 8.0 * f64::EPSILON * 300.0;
+    // Both turned alike: each copy seen from the other is moved by rounding only.
+    for pose in [common::turned_pose(3, 0.4), common::turned_pose(5, 1.4)] {
+        let options = HausdorffOptions::default();
+        let h = hausdorff(&away, &pose, &away, &pose, &options).expect("answers");
+        assert!(h.upper_bound <= rounding, "{h:?}");
+        let at_origin = hausdorff(&near, &pose, &near, &pose, &options).expect("answers");
+        assert!(
+            h.work.nodes_visited * 10 <= at_origin.work.nodes_visited * 11,
+            "{:?} against {:?} at the origin",
+            h.work,
+            at_origin.work
+        );
+    }
+}
+
 #[test]
 fn meshes_match_brute_force_for_every_tree_type() {
     let sphere = common::uv_sphere(1.0, 8, 12);
