@@ -513,6 +513,51 @@ fn a_ridge_between_two_faces_is_closed_exactly() {
     }
 }
 
+/// An equilateral triangle A over three small triangles B at its corners: h(A, B) peaks
+/// at A's centre, inside the face, where the first probe of A's piece (its centroid)
+/// measures it. That measurement raises the lower bound at once, so the pieces around the
+/// peak close against it; the work is pinned.
+#[test]
+fn a_peak_inside_a_face_is_measured_by_the_first_probe() {
+    let s = 3f64.sqrt();
+    let corners = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, s, 0.0]];
+    let face = TriMesh::new(corners.to_vec(), vec![[0, 1, 2]]).expect("a triangle");
+    // Each corner's small triangle lies just below it, pointing to the centre.
+    let mut v = Vec::new();
+    for [x, y, _] in corners {
+        let inward = [1.0 - x, s / 3.0 - y];
+        v.extend([
+            [x, y, -0.01],
+            [x + 0.05 * inward[0] - 0.02, y + 0.05 * inward[1], -0.01],
+            [x + 0.05 * inward[0], y + 0.05 * inward[1] + 0.02, -0.01],
+        ]);
+    }
+    let dots = TriMesh::new(v, vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]]).expect("three dots");
+    let (a, b) = (
+        build(&face, &BuildOptions::default(), None).expect("builds"),
+        build(&dots, &BuildOptions::default(), None).expect("builds"),
+    );
+    let id = Pose::identity();
+    let h = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
+    let centre = [1.0, s / 3.0, 0.0];
+    let off = Vector3::from(h.point_a) - Vector3::from(centre);
+    check(
+        &h,
+        &world_triangles(&a, &id),
+        &world_triangles(&b, &id),
+        (
+            sampled(&world_triangles(&a, &id), &world_triangles(&b, &id), 40),
+            0.0,
+        ),
+        &HausdorffOptions::default(),
+        0.0,
+        "face over dots",
+    );
+    // (Near the centre: the dots are not quite alike as it sees them.)
+    assert!(off.norm() <= 0.05, "the witness is off the centre: {h:?}");
+    assert_eq!(h.work.nodes_visited, 361, "{:?}", h.work);
+}
+
 /// The unit square triangulated along the other diagonal than [`square`]'s, with its
 /// corner (1, 1) raised by `lift`.
 fn flipped_square(lift: f64) -> ObbtFile {
