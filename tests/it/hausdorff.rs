@@ -516,7 +516,8 @@ fn a_ridge_between_two_faces_is_closed_exactly() {
 /// An equilateral triangle A over three small triangles B at its corners: h(A, B) peaks
 /// at A's centre, inside the face, where the first probe of A's piece (its centroid)
 /// measures it. That measurement raises the lower bound at once, so the pieces around the
-/// peak close against it; the work is pinned.
+/// peak close against it; the work is pinned. The bounds close exactly (`check` with no
+/// floor gap): the last few ulps of the peak are found by the probe of a piece at the floor.
 #[test]
 fn a_peak_inside_a_face_is_measured_by_the_first_probe() {
     let s = 3f64.sqrt();
