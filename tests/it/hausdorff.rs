@@ -545,14 +545,12 @@ fn a_peak_inside_a_face_is_found_by_its_probes() {
     let h = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
     let centre = [1.0, s / 3.0, 0.0];
     let off = Vector3::from(h.point_a) - Vector3::from(centre);
+    let (ta, tb) = (world_triangles(&a, &id), world_triangles(&b, &id));
     check(
         &h,
-        &world_triangles(&a, &id),
-        &world_triangles(&b, &id),
-        (
-            sampled(&world_triangles(&a, &id), &world_triangles(&b, &id), 40),
-            0.0,
-        ),
+        &ta,
+        &tb,
+        (sampled(&ta, &tb, 40), 0.0),
         &HausdorffOptions::default(),
         0.0,
         "face over dots",
