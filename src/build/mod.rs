@@ -7,7 +7,10 @@
 //! node holds at most `leaf_size` triangles. The split rule ignores the volume type, so OBB,
 //! AABB and sphere trees of one mesh have the same shape and compare on equal footing.
 
+mod rounding;
 mod topdown;
+
+pub use rounding::{rounding_loss, RoundingLoss, REPORTED_ROUNDING};
 
 use crate::bv::{dispatch, BoundingVolume, BvKind, Layout, LayoutError, NodeType, VolumeVisitor};
 use crate::fit::FitMethod;

@@ -4,7 +4,7 @@ use super::files::check_output;
 use super::progress::with_progress;
 use super::{human_bytes, Failure, WithContext};
 use clap::{Args, ValueEnum};
-use obbtree::build::{build, BuildOptions, SphereFit};
+use obbtree::build::{build, rounding_loss, BuildOptions, SphereFit};
 use obbtree::bv::{BvKind, Layout};
 use obbtree::fit::FitMethod;
 use obbtree::format::{remove_stale_temporaries, ObbtFile};
@@ -320,6 +320,15 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
                 info.placement
             );
         }
+    }
+    // A warning, so shown with --quiet too.
+    if let Some(loss) = rounding_loss(&mesh, &file) {
+        let f64_too = if loss.precision == Precision::F32 {
+            " or --precision f64"
+        } else {
+            ""
+        };
+        eprintln!("warning: {loss}: build with --center{f64_too} to keep the detail");
     }
     Ok(())
 }

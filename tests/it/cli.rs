@@ -380,6 +380,61 @@ fn malformed_poses_and_mismatched_trees_are_exit_1() {
 // pipes; interrupts.
 
 #[test]
+fn build_warns_when_f32_is_coarse_for_the_model_and_says_how_to_keep_it() {
+    let dir = scratch("rounding");
+    let far = dir.join("far.obj");
+    let text = std::fs::read_to_string(cow()).unwrap();
+    let moved: String = text
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(rest) => {
+                let p: Vec<f64> = rest
+                    .split_whitespace()
+                    .map(|w| w.parse().unwrap())
+                    .collect();
+                format!(
+                    "v {} {} {}\n",
+                    p[0] + 30_000.0,
+                    p[1] - 20_000.0,
+                    p[2] + 10_000.0
+                )
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    std::fs::write(&far, moved).unwrap();
+    let out = dir.join("far.obbt");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["build", far.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = obbtree(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    // A warning, not a failure; shown with --quiet too, on one line.
+    let warned = run(&["--quiet", "--force"]);
+    let lines: Vec<&str> = warned.lines().collect();
+    assert_eq!(lines.len(), 1, "{warned}");
+    assert!(
+        lines[0].starts_with("warning: coordinates up to 30000 stored in f32")
+            && lines[0].contains("triangles collapsed to zero area")
+            && lines[0].ends_with("build with --center or --precision f64 to keep the detail"),
+        "{warned}"
+    );
+    for keeps in [&["--center"][..], &["--precision", "f64"]] {
+        let quiet = run(&[&["--quiet", "--force"][..], keeps].concat());
+        assert!(quiet.is_empty(), "{keeps:?}: {quiet}");
+    }
+    // The bundled cow at its origin: no warning.
+    let o = obbtree(&["build", &cow(), "-o", out.to_str().unwrap(), "--quiet"]);
+    assert!(
+        o.status.success() && stderr(&o).is_empty(),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn build_never_overwrites_its_own_input() {
     let dir = scratch("victim");
     let victim = dir.join("victim.obj");

@@ -10,7 +10,7 @@ use crate::common;
 
 use common::mutate::{entry_field, write_uint};
 use common::seal::seal;
-use obbtree::build::{build, BuildError, BuildOptions};
+use obbtree::build::{build, rounding_loss, BuildError, BuildOptions, REPORTED_ROUNDING};
 use obbtree::format::layout::{SectionKind, PLACEMENT_STRIDE};
 use obbtree::format::{AlignedBytes, ObbtFile};
 use obbtree::mesh::TriMesh;
@@ -315,6 +315,65 @@ fn center_brings_a_far_model_to_its_origin() {
         far_error > 10.0 * error,
         "uncentred f32 file: distance off by {far_error}, centred by {error}"
     );
+}
+
+/// The cow moved this far (a part in millimetres 30 m from its assembly's origin): f32
+/// rounds its coordinates by up to 1e-3, a thousandth of its size, which collapses some of
+/// its smallest triangles.
+const VERY_FAR: [f64; 3] = [30_000.0, -20_000.0, 10_000.0];
+
+#[test]
+fn a_build_reports_rounding_that_is_coarse_for_the_model() {
+    let cow = common::cow();
+    let shifted = |by: [f64; 3]| moved(&cow, |p| std::array::from_fn(|k| p[k] + by[k]));
+    let (far, very_far) = (shifted(FAR), shifted(VERY_FAR));
+    let loss = |mesh: &TriMesh, options: &BuildOptions| {
+        rounding_loss(mesh, &build(mesh, options, None).expect("builds"))
+    };
+    let f32_options = BuildOptions::default();
+    // At its origin f32 costs the cow about 6e-8 of its size: nothing to report.
+    assert_eq!(loss(&cow, &f32_options), None);
+    // 982 away, 3e-5 per coordinate: above the reported share, nothing collapsed.
+    let at_far = loss(&far, &f32_options).expect("reported");
+    assert_eq!(at_far.collapsed, 0);
+    assert_eq!(at_far.precision, Precision::F32);
+    assert_eq!(at_far.largest_coordinate, far_coordinate(&far));
+    assert_eq!(at_far.rounding, 2f64.powi(-15), "half an ulp of f32 at 982");
+    assert!(at_far.rounding > REPORTED_ROUNDING * at_far.size);
+    let (lo, hi) = bounds(&far);
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    assert!(
+        (at_far.size - diagonal).abs() < 1e-3 * diagonal,
+        "{at_far:?}"
+    );
+    // 3·10⁴ away: some triangles lose their area, and the warning names them.
+    let at_very_far = loss(&very_far, &f32_options).expect("reported");
+    let stored = build(&very_far, &f32_options, None).expect("builds");
+    let collapsed = stored.info().stats.degenerate_triangles as usize;
+    assert!(collapsed > 0 && cow.degenerate_triangle_count() == 0);
+    assert_eq!(at_very_far.collapsed, collapsed);
+    let line = at_very_far.to_string();
+    assert!(
+        line.contains("stored in f32")
+            && line.contains(&format!("{collapsed} triangles collapsed")),
+        "{line}"
+    );
+    // Centred, or in f64, the same models keep their detail.
+    let centred = BuildOptions {
+        center: true,
+        ..BuildOptions::default()
+    };
+    assert_eq!(loss(&very_far, &centred), None);
+    assert_eq!(loss(&very_far, &f64_options()), None);
+}
+
+/// The largest magnitude of a coordinate of `mesh` rounded to f32, as a file stores it.
+fn far_coordinate(mesh: &TriMesh) -> f64 {
+    let (lo, hi) = bounds(mesh);
+    lo.iter()
+        .chain(&hi)
+        .map(|&x| f64::from(x as f32).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]

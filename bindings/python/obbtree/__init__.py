@@ -159,7 +159,10 @@ def build(
 
     Runs with the GIL released. Raises ``MeshError`` for a mesh that cannot be loaded or
     built, ``OptionError`` (a ValueError) for an option out of range, ``FileError`` (an
-    OSError) for a file that cannot be read or written.
+    OSError) for a file that cannot be read or written. Warns (``UserWarning``) when the
+    stored precision is coarse for the model: coordinates far from the origin for the
+    model's size, rounded by more than 1e-5 of it or collapsing triangles to zero area;
+    ``center=True`` (or ``precision="f64"``) keeps the detail.
     """
     options = dict(
         out=None if out is None else os.fspath(out),

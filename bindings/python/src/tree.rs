@@ -4,13 +4,14 @@ use crate::errors::{Failure, Kind};
 use crate::json::to_python;
 use numpy::ndarray::ArrayView2;
 use numpy::PyArray2;
-use obbtree::build::{build as build_tree, BuildOptions, SphereFit};
+use obbtree::build::{build as build_tree, rounding_loss, BuildOptions, RoundingLoss, SphereFit};
 use obbtree::bv::{BvKind, Layout};
 use obbtree::fit::FitMethod;
 use obbtree::format::layout::SectionKind;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
 use obbtree::real::Precision;
+use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
@@ -416,7 +417,7 @@ pub fn build_tree_from(
     options: BuildOptions,
     force: bool,
 ) -> PyResult<Tree> {
-    let made = py.detach(move || -> Result<Tree, Failure> {
+    let (made, loss) = py.detach(move || -> Result<(Tree, Option<RoundingLoss>), Failure> {
         let (mesh, input) = match source {
             MeshSource::Path(path) => (TriMesh::load(&path)?, Some(path)),
             MeshSource::Arrays(vertices, faces) => (TriMesh::new(vertices, faces)?, None),
@@ -431,8 +432,9 @@ pub fn build_tree_from(
             let f = Failure::from(e);
             Failure::new(f.kind, format!("{label}: {}", f.message))
         })?;
+        let loss = rounding_loss(&mesh, &file);
         match output {
-            None => Ok(Tree::new(file, None)),
+            None => Ok((Tree::new(file, None), loss)),
             Some(out) => {
                 let _ = obbtree::format::remove_stale_temporaries(&out);
                 file.write_atomic(&out).map_err(|e| {
@@ -440,9 +442,20 @@ pub fn build_tree_from(
                 })?;
                 drop(file);
                 let opened = ObbtFile::open(&out)?;
-                Ok(Tree::new(opened, Some(out)))
+                Ok((Tree::new(opened, Some(out)), loss))
             }
         }
     })?;
+    if let Some(loss) = loss {
+        let f64_too = if loss.precision == Precision::F32 {
+            " or precision=\"f64\""
+        } else {
+            ""
+        };
+        let message = format!("{loss}: build with center=True{f64_too} to keep the detail");
+        let category = py.get_type::<PyUserWarning>();
+        // (Level 2: the line that called `obbtree.build`.)
+        PyErr::warn(py, &category, &std::ffi::CString::new(message)?, 2)?;
+    }
     Ok(made)
 }

@@ -1,6 +1,7 @@
 """Trees: zero-copy views, in-memory builds, trimesh input, pickling."""
 
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -56,6 +57,21 @@ def test_in_memory_build_equals_file_build(tmp_path, cow):
     # Queries mixing an in-memory tree and a mapped one.
     assert np.array_equal(obbtree.distance(mem, I, cow, poses).distance,
                           obbtree.distance(cow, I, cow, poses).distance)
+
+
+def test_build_warns_when_f32_is_coarse_for_the_model(tmp_path):
+    verts, faces = load_obj(COW_OBJ)
+    far = verts + [30_000.0, -20_000.0, 10_000.0]
+    with pytest.warns(UserWarning, match=r"triangles collapsed to zero area: build with "
+                      r"center=True or precision=\"f64\" to keep the detail") as caught:
+        obbtree.build((far, faces))
+    # Attributed to the line that called obbtree.build.
+    assert caught[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        obbtree.build((far, faces), center=True)
+        obbtree.build((far, faces), precision="f64")
+        obbtree.build((verts, faces))
 
 
 def test_build_returns_open_mapped_tree(tmp_path):
