@@ -323,12 +323,10 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     }
     // A warning, so shown with --quiet too.
     if let Some(loss) = rounding_loss(&mesh, &file) {
-        let f64_too = if loss.precision == Precision::F32 {
-            " or --precision f64"
-        } else {
-            ""
-        };
-        eprintln!("warning: {loss}: build with --center{f64_too} to keep the detail");
+        match loss.remedy("--center", "--precision f64") {
+            Some(how) => eprintln!("warning: {loss}: {how}"),
+            None => eprintln!("warning: {loss}"),
+        }
     }
     Ok(())
 }

@@ -416,8 +416,8 @@ fn build_warns_when_f32_is_coarse_for_the_model_and_says_how_to_keep_it() {
     let lines: Vec<&str> = warned.lines().collect();
     assert_eq!(lines.len(), 1, "{warned}");
     assert!(
-        lines[0].starts_with("warning: coordinates up to 30000 stored in f32")
-            && lines[0].contains("triangles collapsed to zero area")
+        lines[0].starts_with("warning: stored coordinates up to 30000 in f32")
+            && lines[0].contains(" collapsed to zero area: ")
             && lines[0].ends_with("build with --center or --precision f64 to keep the detail"),
         "{warned}"
     );

@@ -331,7 +331,7 @@ fn a_build_reports_rounding_that_is_coarse_for_the_model() {
         rounding_loss(mesh, &build(mesh, options, None).expect("builds"))
     };
     let f32_options = BuildOptions::default();
-    // At its origin f32 costs the cow about 6e-8 of its size: nothing to report.
+    // At its origin f32 costs the cow about 2e-8 of its size: nothing to report.
     assert_eq!(loss(&cow, &f32_options), None);
     // 982 away, 3e-5 per coordinate: above the reported share, nothing collapsed.
     let at_far = loss(&far, &f32_options).expect("reported");
@@ -346,6 +346,11 @@ fn a_build_reports_rounding_that_is_coarse_for_the_model() {
         (at_far.size - diagonal).abs() < 1e-3 * diagonal,
         "{at_far:?}"
     );
+    let both = "build with --center or --precision f64 to keep the detail";
+    assert_eq!(
+        at_far.remedy("--center", "--precision f64").as_deref(),
+        Some(both)
+    );
     // 3·10⁴ away: some triangles lose their area, and the warning names them.
     let at_very_far = loss(&very_far, &f32_options).expect("reported");
     let stored = build(&very_far, &f32_options, None).expect("builds");
@@ -354,17 +359,61 @@ fn a_build_reports_rounding_that_is_coarse_for_the_model() {
     assert_eq!(at_very_far.collapsed, collapsed);
     let line = at_very_far.to_string();
     assert!(
-        line.contains("stored in f32")
-            && line.contains(&format!("{collapsed} triangles collapsed")),
+        line.starts_with("stored coordinates up to 30000 in f32 move by up to 9.8e-4")
+            && line.ends_with(&format!("; {collapsed} triangles collapsed to zero area")),
         "{line}"
     );
-    // Centred, or in f64, the same models keep their detail.
+    // Centred, or in f64 (stored exactly as given), the same models keep their detail.
     let centred = BuildOptions {
         center: true,
         ..BuildOptions::default()
     };
     assert_eq!(loss(&very_far, &centred), None);
     assert_eq!(loss(&very_far, &f64_options()), None);
+    // In f64 with a placement, storing rounds: by a few 1e-12 here, nothing to report.
+    let placed = BuildOptions {
+        scale: 3.0,
+        ..f64_options()
+    };
+    assert_eq!(loss(&very_far, &placed), None);
+}
+
+#[test]
+fn collapsed_triangles_are_counted_face_by_face() {
+    // Near the origin: a sliver whose apex lies 1e-10 off its base at height 1, where f32
+    // cannot hold it (it collapses), and a triangle collinear in the input that f32 gives
+    // an area. The second does not cancel the first in the count, and centring cannot
+    // help: only f64 keeps the sliver.
+    let vertices = vec![
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.5, 1.0 + 1e-10, 0.0],
+        [0.5, 2.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [0.2997118905373848, 0.42268722119765845, 0.0],
+        [1.498559452686924, 2.113436105988292, 0.0],
+    ];
+    let faces = vec![[0, 1, 2], [0, 1, 3], [4, 5, 6]];
+    let mesh = TriMesh::new(vertices, faces).expect("a mesh");
+    assert_eq!(mesh.degenerate_triangle_count(), 1, "the collinear one");
+    let file = build(&mesh, &BuildOptions::default(), None).expect("builds");
+    assert_eq!(file.info().stats.degenerate_triangles, 1, "the sliver");
+    let loss = rounding_loss(&mesh, &file).expect("the sliver collapsed");
+    assert_eq!(loss.collapsed, 1);
+    assert_eq!(loss.rounding, 2f64.powi(-23), "half an ulp of f32 at 2.1");
+    assert!(loss
+        .to_string()
+        .ends_with("; 1 triangle collapsed to zero area"));
+    assert_eq!(
+        loss.remedy("--center", "--precision f64").as_deref(),
+        Some("build with --precision f64 to keep the detail")
+    );
+    let f64_file = build(&mesh, &f64_options(), None).expect("builds");
+    assert_eq!(rounding_loss(&mesh, &f64_file), None);
+    // A model of no size (one point) is not reported, whatever its coordinates.
+    let point = TriMesh::new(vec![[1e6; 3]; 3], vec![[0, 1, 2]]).expect("a mesh");
+    let file = build(&point, &BuildOptions::default(), None).expect("builds");
+    assert_eq!(rounding_loss(&point, &file), None);
 }
 
 /// The largest magnitude of a coordinate of `mesh` rounded to f32, as a file stores it.

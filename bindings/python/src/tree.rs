@@ -447,12 +447,10 @@ pub fn build_tree_from(
         }
     })?;
     if let Some(loss) = loss {
-        let f64_too = if loss.precision == Precision::F32 {
-            " or precision=\"f64\""
-        } else {
-            ""
+        let message = match loss.remedy("center=True", "precision=\"f64\"") {
+            Some(how) => format!("{loss}: {how}"),
+            None => loss.to_string(),
         };
-        let message = format!("{loss}: build with center=True{f64_too} to keep the detail");
         let category = py.get_type::<PyUserWarning>();
         // (Level 2: the line that called `obbtree.build`.)
         PyErr::warn(py, &category, &std::ffi::CString::new(message)?, 2)?;
