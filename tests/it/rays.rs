@@ -632,3 +632,45 @@ fn the_one_model_commands_answer_alike_on_any_thread_count() {
         assert_eq!(printed[0], printed[1], "{command:?}");
     }
 }
+
+/// Triangles whose boxes share one centre (nested copies of a triangle) give the index's
+/// builder no plane to split by; more of them than a leaf holds are halved as they lie,
+/// so a ray past the small ones tests the large ones only.
+#[test]
+fn nested_triangles_with_one_centre_are_split_so_rays_skip_the_small_ones() {
+    // Sixteen copies of a triangle whose box is centred on the origin, scaled 1 to 16.
+    let copies = 16u32;
+    let mut vertices = Vec::new();
+    let mut faces = Vec::new();
+    for k in 1..=copies {
+        let s = f64::from(k);
+        let first = vertices.len() as u32;
+        vertices.extend([[-s, -s, 0.0], [s, -s, 0.0], [0.0, s, 0.0]]);
+        faces.push([first, first + 1, first + 2]);
+    }
+    let mesh = obbtree::mesh::TriMesh::new(vertices, faces).expect("a mesh");
+    let file = common::tree_f64(&mesh);
+    // Down through the point of each copy's base: inside copies k and up, outside the
+    // smaller ones (their boxes do not reach it).
+    let down = |y: f64| Ray {
+        origin: [0.0, y, 1.0],
+        direction: [0.0, 0.0, -1.0],
+    };
+    let rays: Vec<Ray> = (1..=copies).map(|k| down(-(f64::from(k) - 0.5))).collect();
+    let options = RayOptions {
+        mode: RayMode::Closest,
+        t_max: f64::INFINITY,
+    };
+    let answers = cast_rays(&file, &Pose::identity(), &rays, &options).expect("answers");
+    for (k, answer) in (1..=copies).zip(&answers) {
+        // Every copy hit lies at t = 1; the tie goes to the smallest id: copy k's.
+        let hit = answer.hit.expect("a hit");
+        assert_eq!((hit.t, hit.triangle), (1.0, k - 1), "ray {k}");
+        let tested = answer.work.tri_separated + answer.work.tri_contact;
+        // One leaf of all sixteen would test every copy; halving leaves the ray past the
+        // smaller half's box at most the larger half and a leaf of the smaller.
+        if k > copies / 2 {
+            assert!(tested <= u64::from(copies / 2), "ray {k} tested {tested}");
+        }
+    }
+}
