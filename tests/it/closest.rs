@@ -316,3 +316,26 @@ fn a_sliver_gets_its_nearest_point() {
     assert!((reference - 1.6051518805091713).abs() < 1e-9, "{reference}");
     assert!(((p - q).norm() - reference).abs() < 1e-12, "{q:?}");
 }
+
+/// Triangles of no area along one axis-aligned line make boxes of no area: the index's
+/// surface-area cost cannot weigh a split of them, and a group a leaf can hold stays one
+/// leaf (the cost of its children is taken as the parent's), so a point tests them all.
+#[test]
+fn a_few_triangles_of_no_area_on_one_line_stay_one_leaf() {
+    // Four segments along x (each a triangle with a repeated corner), one after another.
+    let vertices: Vec<[f64; 3]> = (0..8).map(|i| [f64::from(i), 0.0, 0.0]).collect();
+    let faces = vec![[0, 1, 1], [2, 3, 3], [4, 5, 5], [6, 7, 7]];
+    let mesh = obbtree::mesh::TriMesh::new(vertices, faces).expect("a mesh");
+    let file = common::tree_f64(&mesh);
+    let answers = closest_points(
+        &file,
+        &Pose::identity(),
+        &[[0.5, 1.0, 0.0]],
+        &ClosestOptions::default(),
+    )
+    .expect("answers");
+    let answer = &answers[0];
+    let closest = answer.closest.expect("a closest point");
+    assert_eq!((closest.triangle, closest.distance), (0, 1.0));
+    assert_eq!(answer.work.tri_separated + answer.work.tri_contact, 4);
+}
