@@ -54,6 +54,15 @@ impl RoundingLoss {
         };
         Some(format!("build with {how} to keep the detail"))
     }
+
+    /// The whole warning, one line: what was lost, then [`RoundingLoss::remedy`] where
+    /// one would help, its options spelled as the caller takes them.
+    pub fn warning(&self, center: &str, f64: &str) -> String {
+        match self.remedy(center, f64) {
+            Some(how) => format!("{self}: {how}"),
+            None => self.to_string(),
+        }
+    }
 }
 
 /// What building `file` from `mesh` cost in precision, if it is worth telling: some
@@ -94,7 +103,13 @@ pub fn rounding_loss(mesh: &TriMesh, file: &ObbtFile) -> Option<RoundingLoss> {
     } else {
         half_ulp(info.precision, largest_coordinate)
     };
-    let collapsed = file.visit(Collapsed { mesh }).unwrap_or(0);
+    // (Only a file with triangles of no area can have collapsed any: most builds skip the
+    // pass.)
+    let collapsed = if info.stats.degenerate_triangles == 0 {
+        0
+    } else {
+        file.visit(Collapsed { mesh }).unwrap_or(0)
+    };
     let coarse = rounding > REPORTED_ROUNDING * size;
     // (A non-finite size is no model to speak of.)
     ((collapsed > 0 || coarse) && size.is_finite() && size > 0.0).then_some(RoundingLoss {
@@ -164,8 +179,7 @@ fn half_ulp(precision: Precision, x: f64) -> f64 {
 }
 
 impl fmt::Display for RoundingLoss {
-    /// What was lost, in one line (callers add [`RoundingLoss::remedy`], spelled as they
-    /// take options).
+    /// What was lost, in one line ([`RoundingLoss::warning`] adds how to keep it).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let name = match self.precision {
             Precision::F32 => "f32",

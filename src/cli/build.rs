@@ -323,10 +323,7 @@ pub fn run(args: &BuildArgs) -> Result<(), Failure> {
     }
     // A warning, so shown with --quiet too.
     if let Some(loss) = rounding_loss(&mesh, &file) {
-        match loss.remedy("--center", "--precision f64") {
-            Some(how) => eprintln!("warning: {loss}: {how}"),
-            None => eprintln!("warning: {loss}"),
-        }
+        eprintln!("warning: {}", loss.warning("--center", "--precision f64"));
     }
     Ok(())
 }

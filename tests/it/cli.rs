@@ -383,26 +383,14 @@ fn malformed_poses_and_mismatched_trees_are_exit_1() {
 fn build_warns_when_f32_is_coarse_for_the_model_and_says_how_to_keep_it() {
     let dir = scratch("rounding");
     let far = dir.join("far.obj");
-    let text = std::fs::read_to_string(cow()).unwrap();
-    let moved: String = text
-        .lines()
-        .map(|line| match line.strip_prefix("v ") {
-            Some(rest) => {
-                let p: Vec<f64> = rest
-                    .split_whitespace()
-                    .map(|w| w.parse().unwrap())
-                    .collect();
-                format!(
-                    "v {} {} {}\n",
-                    p[0] + 30_000.0,
-                    p[1] - 20_000.0,
-                    p[2] + 10_000.0
-                )
-            }
-            None => format!("{line}\n"),
-        })
+    let mesh = common::cow();
+    let moved = mesh
+        .vertices()
+        .iter()
+        .map(|p| [p[0] + 30_000.0, p[1] - 20_000.0, p[2] + 10_000.0])
         .collect();
-    std::fs::write(&far, moved).unwrap();
+    let moved = obbtree::mesh::TriMesh::new(moved, mesh.faces().to_vec()).unwrap();
+    std::fs::write(&far, moved.to_obj()).unwrap();
     let out = dir.join("far.obbt");
     let run = |extra: &[&str]| {
         let mut args = vec!["build", far.to_str().unwrap(), "-o", out.to_str().unwrap()];

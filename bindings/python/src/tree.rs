@@ -447,10 +447,7 @@ pub fn build_tree_from(
         }
     })?;
     if let Some(loss) = loss {
-        let message = match loss.remedy("center=True", "precision=\"f64\"") {
-            Some(how) => format!("{loss}: {how}"),
-            None => loss.to_string(),
-        };
+        let message = loss.warning("center=True", "precision=\"f64\"");
         let category = py.get_type::<PyUserWarning>();
         // (Level 2: the line that called `obbtree.build`.)
         PyErr::warn(py, &category, &std::ffi::CString::new(message)?, 2)?;
