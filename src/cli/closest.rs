@@ -49,14 +49,16 @@ pub struct ClosestArgs {
 
 pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
     let pose = args.pose.pose()?;
-    let points = args.query.rows()?;
+    let rows = args.query.rows()?;
+    let points = &rows.values;
     let model = open_model(&args.model, &args.tree)?;
     let options = ClosestOptions {
         max_distance: args.max_distance.unwrap_or(f64::INFINITY),
     };
     let answers = with_threads(args.threads.threads, || {
-        closest_points(&model, &pose, &points, &options)
-    })??;
+        closest_points(&model, &pose, points, &options)
+    })?
+    .map_err(|e| rows.locate(e))?;
     if args.csv {
         out!("point,distance,x,y,z,triangle,feature,feature_index,bv_tests,tri_tests")?;
     }

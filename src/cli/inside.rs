@@ -67,7 +67,8 @@ pub struct InsideArgs {
 
 pub fn run(args: &InsideArgs) -> Result<(), Failure> {
     let pose = args.pose.pose()?;
-    let points = args.query.rows()?;
+    let rows = args.query.rows()?;
+    let points = &rows.values;
     let accuracy = match args.tolerance {
         Some(0.0) => WindingAccuracy::Exact,
         Some(tolerance) => WindingAccuracy::Bounded { tolerance },
@@ -75,10 +76,10 @@ pub fn run(args: &InsideArgs) -> Result<(), Failure> {
     };
     let model = open_model(&args.model, &args.tree)?;
     let answer = || -> Result<_, QueryError> {
-        let winding = winding_numbers(&model, &pose, &points, &WindingOptions { accuracy })?;
+        let winding = winding_numbers(&model, &pose, points, &WindingOptions { accuracy })?;
         // The signed distance: the closest point's distance, signed by the winding number.
         let signed: Vec<Option<f64>> = if args.distance {
-            closest_points(&model, &pose, &points, &ClosestOptions::default())?
+            closest_points(&model, &pose, points, &ClosestOptions::default())?
                 .iter()
                 .zip(&winding)
                 .map(|(c, w)| Some(w.signed(c.distance())))
@@ -88,7 +89,8 @@ pub fn run(args: &InsideArgs) -> Result<(), Failure> {
         };
         Ok((winding, signed))
     };
-    let (winding, signed) = with_threads(args.threads.threads, answer)??;
+    let (winding, signed) =
+        with_threads(args.threads.threads, answer)?.map_err(|e| rows.locate(e))?;
     if args.csv {
         let distance = if args.distance {
             ",signed_distance"

@@ -85,6 +85,7 @@ pub fn run(args: &RayArgs) -> Result<(), Failure> {
         "ox oy oz dx dy dz",
     )?;
     let rays: Vec<Ray> = rows
+        .values
         .iter()
         .map(|[ox, oy, oz, dx, dy, dz]| Ray {
             origin: [*ox, *oy, *oz],
@@ -113,7 +114,7 @@ pub fn run(args: &RayArgs) -> Result<(), Failure> {
             }
         })
     };
-    let answers = with_threads(args.threads.threads, cast)??;
+    let answers = with_threads(args.threads.threads, cast)?.map_err(|e| rows.locate(e))?;
     if args.csv {
         out!("ray,hit,t,x,y,z,triangle,b0,b1,b2,nx,ny,nz,bv_tests,tri_tests")?;
     }

@@ -4,8 +4,42 @@
 use super::poses::parse_numbers;
 use super::{Failure, WithContext};
 use clap::Args;
+use obbtree::query::QueryError;
 use std::io::Read;
 use std::path::{Path, PathBuf};
+
+/// Rows of `N` numbers read by [`numeric_rows`], with where each one was read.
+pub struct Rows<const N: usize> {
+    /// The rows, in input order.
+    pub values: Vec<[f64; N]>,
+    /// The flag, file name or `<stdin>` they came from.
+    source: String,
+    /// Each row's line number (from 1) in a file; empty for a flag's one row.
+    lines: Vec<usize>,
+}
+
+impl<const N: usize> Rows<N> {
+    /// `error`, a query's over these rows, with the place of the row it names in front
+    /// (`FILE: line L: ray 3: ...`): a batch index alone does not say which line to mend.
+    pub fn locate(&self, error: QueryError) -> Failure {
+        let place = match &error {
+            // (Not the model's own triangles, which the error names otherwise.)
+            QueryError::BadInput {
+                what: "query point" | "ray",
+                index,
+                ..
+            } => match self.lines.get(*index) {
+                Some(line) => Some(format!("{}: line {line}", self.source)),
+                None => Some(self.source.clone()),
+            },
+            _ => None,
+        };
+        match place {
+            Some(place) => Failure::from(error).context(place),
+            None => error.into(),
+        }
+    }
+}
 
 /// The rows of `N` numbers (named `names`, e.g. `x y z`) given by exactly one of
 /// `single` (the text of flag `single_flag`) and `file` (a path, `-` for stdin, of lines
@@ -16,7 +50,7 @@ pub fn numeric_rows<const N: usize>(
     file: Option<&Path>,
     file_flag: &str,
     names: &str,
-) -> Result<Vec<[f64; N]>, Failure> {
+) -> Result<Rows<N>, Failure> {
     let row = |numbers: Vec<f64>, at: &dyn Fn() -> String| -> Result<[f64; N], Failure> {
         <[f64; N]>::try_from(numbers.as_slice()).map_err(|_| {
             Failure::msg(format!(
@@ -27,9 +61,13 @@ pub fn numeric_rows<const N: usize>(
         })
     };
     match (single, file) {
-        (Some(text), None) => Ok(vec![row(parse_numbers(text, single_flag)?, &|| {
-            single_flag.into()
-        })?]),
+        (Some(text), None) => Ok(Rows {
+            values: vec![row(parse_numbers(text, single_flag)?, &|| {
+                single_flag.into()
+            })?],
+            source: single_flag.into(),
+            lines: Vec::new(),
+        }),
         (None, Some(path)) => {
             let stdin = path.as_os_str() == "-";
             let shown = if stdin {
@@ -46,19 +84,24 @@ pub fn numeric_rows<const N: usize>(
                 text = std::fs::read_to_string(path)
                     .with_context(|| format!("{shown}: cannot read"))?;
             }
-            let mut rows = Vec::new();
+            let (mut values, mut lines) = (Vec::new(), Vec::new());
             for (line, content) in text.lines().enumerate() {
                 let content = content.trim();
                 if content.is_empty() || content.starts_with('#') {
                     continue;
                 }
                 let at = || format!("{shown}: line {}", line + 1);
-                rows.push(row(parse_numbers(content, &at())?, &at)?);
+                values.push(row(parse_numbers(content, &at())?, &at)?);
+                lines.push(line + 1);
             }
-            if rows.is_empty() {
+            if values.is_empty() {
                 return Err(Failure::msg(format!("{shown}: no rows of {names}")));
             }
-            Ok(rows)
+            Ok(Rows {
+                values,
+                source: shown,
+                lines,
+            })
         }
         _ => Err(Failure::msg(format!(
             "give {single_flag} or {file_flag} FILE (- for stdin)"
@@ -86,7 +129,7 @@ pub struct PointArgs {
 
 impl PointArgs {
     /// The points given.
-    pub fn rows(&self) -> Result<Vec<[f64; 3]>, Failure> {
+    pub fn rows(&self) -> Result<Rows<3>, Failure> {
         numeric_rows::<3>(
             self.point.as_deref(),
             "--point X,Y,Z",

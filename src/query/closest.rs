@@ -104,7 +104,7 @@ pub fn closest_points(
             value: options.max_distance,
         });
     }
-    check_points(points)?;
+    check_points(points, &Pose::relative(pose, &Pose::identity()))?;
     /// The typed descent, run for every point.
     struct Visit<'q> {
         model: &'q ObbtFile,
@@ -118,6 +118,7 @@ pub fn closest_points(
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
             let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
+            index.check_reach(&tree, "model triangle")?;
             // Runs of points in input order, each point's descent seeded with the triangle
             // its predecessor in the run found: fixed runs keep the answers independent of
             // the thread count. One heap per worker, reused point after point.

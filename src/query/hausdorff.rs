@@ -27,7 +27,7 @@ use super::engine::{corrupt, triangle};
 use super::index::point::Found;
 use super::index::{Child, SurfaceIndex};
 use super::triangle::{closest_point_on_triangle, convex_union, Triangle};
-use super::{QueryError, Side, Work};
+use super::{check_reach, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
@@ -174,10 +174,9 @@ pub fn hausdorff(
             .map(|w| (w.point, w.triangle))
     };
     let ab = one_sided(
-        a,
-        pose_a,
-        b,
-        pose_b,
+        (a, pose_a),
+        (b, pose_b),
+        Side::B,
         options,
         seed(HausdorffDirection::AToB),
     )?;
@@ -200,10 +199,9 @@ pub fn hausdorff(
         return Ok(forward);
     }
     let ba = one_sided(
-        b,
-        pose_b,
-        a,
-        pose_a,
+        (b, pose_b),
+        (a, pose_a),
+        Side::A,
         options,
         seed(HausdorffDirection::BToA),
     )?;
@@ -251,10 +249,9 @@ struct OneSided {
 /// h(from, to), its search started from `seed` (a point of `from` in its model frame, and
 /// its triangle's input id) when given.
 fn one_sided(
-    from: &ObbtFile,
-    pose_from: &Pose,
-    to: &ObbtFile,
-    pose_to: &Pose,
+    (from, pose_from): (&ObbtFile, &Pose),
+    (to, pose_to): (&ObbtFile, &Pose),
+    to_side: Side,
     options: &HausdorffOptions,
     seed: Option<([f64; 3], u32)>,
 ) -> Result<OneSided, QueryError> {
@@ -319,16 +316,32 @@ fn one_sided(
         from_to_to: Pose::relative(pose_to, pose_from),
         seed,
     })??;
+    // Distances are compared squared in `to`'s frame (see `MAX_COORDINATE`).
+    let (from_vertex, to_triangle, in_to_frame) = match to_side {
+        Side::B => (
+            "model A vertex",
+            "model B triangle",
+            "coordinates must be within ±1e150 in model B's frame",
+        ),
+        Side::A => (
+            "model B vertex",
+            "model A triangle",
+            "coordinates must be within ±1e150 in model A's frame",
+        ),
+    };
+    check_reach(from_vertex, in_to_frame, from.vertices.iter().copied())?;
     /// The bounds, run on `to`'s typed tree.
     struct Bounds<'q> {
         to: &'q ObbtFile,
         from: &'q FromModel,
         options: &'q HausdorffOptions,
+        to_triangle: &'static str,
     }
     impl TreeVisitor for Bounds<'_> {
         type Output = Result<Local, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             let index = self.to.derived(|| SurfaceIndex::build(&tree))?;
+            index.check_reach(&tree, self.to_triangle)?;
             let to = To {
                 tree: &tree,
                 index: &index,
@@ -340,6 +353,7 @@ fn one_sided(
         to,
         from: &from,
         options,
+        to_triangle,
     })??;
     let from_point = pose_to.apply(&local.from_point);
     Ok(OneSided {

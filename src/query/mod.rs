@@ -101,7 +101,7 @@ pub enum QueryError {
         what: &'static str,
     },
     /// An option value is out of range.
-    #[error("{name} must be {requirement}, got {value}")]
+    #[error("{name} must be {requirement}, got {}", shown(*value))]
     BadOption {
         /// The option.
         name: &'static str,
@@ -111,7 +111,7 @@ pub enum QueryError {
         value: f64,
     },
     /// One query of a batch (a ray, a point) is unusable.
-    #[error("{what} {index}: {requirement}, got {value}")]
+    #[error("{what} {index}: {requirement}, got {}", shown(*value))]
     BadInput {
         /// What it is: `ray`, `query point`.
         what: &'static str,
@@ -127,6 +127,16 @@ pub enum QueryError {
     Format(#[from] crate::format::FormatError),
 }
 
+/// `value` as an error message shows it: as Rust prints it, or in scientific notation
+/// where that would be a long run of digits.
+fn shown(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() || (1e-5..1e16).contains(&value.abs()) {
+        value.to_string()
+    } else {
+        format!("{value:e}")
+    }
+}
+
 /// The input-mesh id of leaf-ordered face `face`.
 pub(crate) fn source_id<B: crate::bv::BoundingVolume>(
     tree: &crate::tree::TreeView<'_, B>,
@@ -139,19 +149,54 @@ pub(crate) fn source_id<B: crate::bv::BoundingVolume>(
     })
 }
 
-/// The error naming the first query point with a non-finite coordinate.
-pub(crate) fn check_points(points: &[[f64; 3]]) -> Result<(), QueryError> {
+/// The largest magnitude of a coordinate, in the frame of the model measured, that closest
+/// points, winding numbers, signed distances and Hausdorff distances accept: of the query
+/// points, of the measured model's own triangles, and of the other model's vertices posed
+/// in that frame. They compare squared distances, which beyond it could overflow. Rays,
+/// collision, distance, tolerance and span take any finite coordinates.
+pub const MAX_COORDINATE: f64 = 1e150;
+
+/// What [`QueryError::BadInput`] requires of a coordinate beyond [`MAX_COORDINATE`].
+pub(crate) const WITHIN_REACH: &str = "coordinates must be within ±1e150 in the model's frame";
+
+/// The error naming the first query point with a non-finite coordinate, or one beyond
+/// [`MAX_COORDINATE`] once `to_model` maps it into the model's frame.
+pub(crate) fn check_points(points: &[[f64; 3]], to_model: &Pose) -> Result<(), QueryError> {
+    let bad = |index, requirement, value| QueryError::BadInput {
+        what: "query point",
+        index,
+        requirement,
+        value,
+    };
     for (index, p) in points.iter().enumerate() {
-        if let Some(bad) = p.iter().find(|x| !x.is_finite()) {
-            return Err(QueryError::BadInput {
-                what: "query point",
-                index,
-                requirement: "coordinates must be finite",
-                value: *bad,
-            });
+        if let Some(x) = p.iter().find(|x| !x.is_finite()) {
+            return Err(bad(index, "coordinates must be finite", *x));
         }
     }
-    Ok(())
+    let posed = points.iter().map(|p| to_model.apply(&(*p).into()));
+    check_reach("query point", WITHIN_REACH, posed)
+}
+
+/// The error naming the first of `points` (model frame) with a coordinate beyond
+/// [`MAX_COORDINATE`] as `what` and its position.
+pub(crate) fn check_reach(
+    what: &'static str,
+    requirement: &'static str,
+    points: impl IntoIterator<Item = nalgebra::Vector3<f64>>,
+) -> Result<(), QueryError> {
+    match points
+        .into_iter()
+        .enumerate()
+        .find(|(_, p)| !(p.amax() <= MAX_COORDINATE))
+    {
+        Some((index, p)) => Err(QueryError::BadInput {
+            what,
+            index,
+            requirement,
+            value: p.amax(),
+        }),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]

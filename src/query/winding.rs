@@ -160,7 +160,7 @@ fn winding_numbers_with(
         }
         _ => {}
     }
-    check_points(points)?;
+    check_points(points, &Pose::relative(pose, &Pose::identity()))?;
     /// The typed descent, run for every point.
     struct Visit<'q> {
         model: &'q ObbtFile,
@@ -174,6 +174,7 @@ fn winding_numbers_with(
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             // Both made at the file's first such query and kept with it.
             let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
+            index.check_reach(&tree, "model triangle")?;
             let clusters = self.model.derived(|| Clusters::of(&index))?;
             let to_model = Pose::relative(self.pose, &Pose::identity());
             // The descent is made for each rule, so that no step asks which rule it follows.
@@ -319,15 +320,24 @@ impl Clusters {
             .zip(radii.chunks_exact(WIDTH))
             .map(|(lanes, radius)| {
                 let m: [Moment; WIDTH] = lanes.try_into().unwrap_or([Moment::default(); WIDTH]);
+                let expansions = m.map(|m| Expansion::of(&m));
+                let mut radius: [f64; WIDTH] = radius.try_into().unwrap_or([0.0; WIDTH]);
+                // A cluster whose moments overflowed (coordinates beyond about 1e75) is
+                // never far enough away: it is opened, down to its triangles' exact angles.
+                for (r, e) in radius.iter_mut().zip(&expansions) {
+                    if !e.is_finite() {
+                        *r = f64::INFINITY;
+                    }
+                }
                 ClusterNode {
                     centroid: [
                         m.map(|m| m.centroid.x),
                         m.map(|m| m.centroid.y),
                         m.map(|m| m.centroid.z),
                     ],
-                    radius: radius.try_into().unwrap_or([0.0; WIDTH]),
+                    radius,
                     area: m.map(|m| m.area),
-                    expansions: m.map(|m| Expansion::of(&m)),
+                    expansions,
                 }
             })
             .collect();
@@ -488,15 +498,25 @@ fn centre(
 /// The solid angle of triangle `t` seen from the origin, signed by the triangle's
 /// orientation (Van Oosterom and Strackee's formula); 0 when the origin lies on it.
 fn solid_angle(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> f64 {
-    let numerator = a.dot(&b.cross(c));
+    let terms = |a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>| {
+        let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+        let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+        (a.dot(&b.cross(c)), denominator)
+    };
+    let (mut numerator, mut denominator) = terms(a, b, c);
     // In the triangle's plane the formula gives ±2π on the triangle (the sign of a zero)
     // and 0 beside it. 0 on it too is the mean of the two sides' limits, so that a point
     // on a closed surface gets the share of directions looking inside (½ on a face).
     if numerator == 0.0 {
         return 0.0;
     }
-    let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
-    let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    if !(numerator.is_finite() && denominator.is_finite()) {
+        // Far from the origin the cubes overflow. The angle does not change with scale,
+        // and a power of two scales exactly: once more at about unit size.
+        let largest = a.amax().max(b.amax()).max(c.amax());
+        let scale = 2f64.powi(-(largest.log2().ceil() as i32));
+        (numerator, denominator) = terms(&(a * scale), &(b * scale), &(c * scale));
+    }
     2.0 * numerator.atan2(denominator)
 }
 
@@ -523,6 +543,24 @@ struct Expansion {
 }
 
 impl Expansion {
+    /// Whether every coefficient is a finite number.
+    fn is_finite(&self) -> bool {
+        let Expansion {
+            normal,
+            trace,
+            square,
+            linear,
+            cubic,
+        } = self;
+        normal
+            .iter()
+            .chain([trace])
+            .chain(square)
+            .chain(linear)
+            .chain(cubic)
+            .all(|c| c.is_finite())
+    }
+
     fn of(m: &Moment) -> Expansion {
         let s = &m.spread;
         let bend = &m.bend;
@@ -574,20 +612,25 @@ impl Expansion {
     }
 
     /// The cluster's solid angle seen from `u` away from its centroid, `inverse = 1/|u|`,
-    /// each `a b + c` rounded as `A` does.
+    /// each `a b + c` rounded as `A` does. The forms are taken of the unit direction
+    /// `w = u/d` and scaled by powers of `1/d`,
+    /// `d⁻² (N·w + d⁻¹ (tr spread − 3 wᵀ spread w) + d⁻² (C(w) − v·w))`: no power of the
+    /// distance is formed, so a point however far gives a finite angle, not `∞ · 0`.
     #[inline(always)]
-    fn solid_angle<A: MulAdd>(&self, [x, y, z]: [f64; 3], inverse: f64) -> f64 {
+    fn solid_angle<A: MulAdd>(&self, u: [f64; 3], inverse: f64) -> f64 {
+        let [x, y, z] = u.map(|c| c * inverse);
         let [nx, ny, nz] = self.normal;
         let [xx, yy, zz, xy, yz, zx] = self.square;
         let [vx, vy, vz] = self.linear;
         let [xxx, yyy, zzz, xxy, xxz, xyy, yyz, xzz, yzz, xyz] = self.cubic;
         let f = A::mul_add;
-        let first = f(nx, x, f(ny, y, f(nz, z, self.trace)));
-        let second = f(
+        let first = f(nx, x, f(ny, y, nz * z));
+        let square = f(
             x,
-            f(xx, x, f(xy, y, vx)),
-            f(y, f(yy, y, f(yz, z, vy)), z * f(zz, z, f(zx, x, vz))),
+            f(xx, x, xy * y),
+            f(y, f(yy, y, yz * z), z * f(zz, z, zx * x)),
         );
+        let linear = f(vx, x, f(vy, y, vz * z));
         let third = f(
             x * x,
             f(xxx, x, f(xxy, y, xxz * z)),
@@ -597,8 +640,13 @@ impl Expansion {
                 f(z * z, f(zzz, z, f(xzz, x, yzz * y)), xyz * x * y * z),
             ),
         );
-        let inverse2 = inverse * inverse;
-        inverse2 * inverse * f(-inverse2, f(-inverse2, third, second), first)
+        inverse
+            * inverse
+            * f(
+                inverse,
+                f(inverse, third - linear, self.trace - square),
+                first,
+            )
     }
 }
 

@@ -339,3 +339,68 @@ fn a_few_triangles_of_no_area_on_one_line_stay_one_leaf() {
     assert_eq!((closest.triangle, closest.distance), (0, 1.0));
     assert_eq!(answer.work.tri_separated + answer.work.tri_contact, 4);
 }
+
+/// Closest points compare squared distances, which overflow past `MAX_COORDINATE`: a
+/// query point placed beyond it (by its coordinates or by the model's pose) and a model
+/// whose own triangles reach beyond it are refused by name, with the point's line when it
+/// came from a file; a point at the limit is answered.
+#[test]
+fn coordinates_beyond_reach_are_refused_by_name_and_the_limit_is_answered() {
+    use obbtree::query::MAX_COORDINATE;
+    let file = build(&common::cube(0.5), &Default::default(), None).expect("builds");
+    let id = Pose::identity();
+    let far = MAX_COORDINATE;
+    let answers =
+        closest_points(&file, &id, &[[far, 0.0, 0.0]], &Default::default()).expect("answers");
+    let d = answers[0].distance();
+    assert!((d - (far - 0.5)).abs() <= 1e-12 * far, "{d}");
+    let refused = |pose: &Pose, points: &[[f64; 3]], file: &ObbtFile| {
+        closest_points(file, pose, points, &Default::default()).expect_err("refused")
+    };
+    let beyond = [[0.0; 3], [0.0, -1.5 * far, 0.0]];
+    let moved = Pose::translation(2.0 * far, 0.0, 0.0);
+    for error in [
+        refused(&id, &beyond, &file),
+        refused(&moved, &[[0.0; 3]], &file),
+    ] {
+        assert!(
+            matches!(
+                error,
+                QueryError::BadInput {
+                    what: "query point",
+                    ..
+                }
+            ),
+            "{error}"
+        );
+        assert!(error.to_string().contains("within ±1e150"), "{error}");
+    }
+    let huge = obbtree::build::BuildOptions {
+        precision: obbtree::real::Precision::F64,
+        scale: 10.0 * far,
+        ..Default::default()
+    };
+    let huge = build(&common::cube(0.5), &huge, None).expect("builds");
+    let error = refused(&id, &[[0.0; 3]], &huge);
+    assert!(
+        matches!(
+            error,
+            QueryError::BadInput {
+                what: "model triangle",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert!(error.to_string().ends_with("got 5e150"), "{error}");
+    // The CLI names the line of a file's bad point (a comment and a blank line before it).
+    use common::cli::{assert_bad_input, cow, obbtree, scratch};
+    let dir = scratch("closest-reach");
+    let points = dir.join("points.txt");
+    std::fs::write(&points, "# x y z\n0 0 0\n\n0 2e150 0\n").expect("writes");
+    let points = points.to_str().expect("a path");
+    assert_bad_input(
+        &obbtree(&["closest", cow().as_str(), "--points", points]),
+        &format!("{points}: line 4: query point 1: coordinates must be within ±1e150"),
+    );
+}

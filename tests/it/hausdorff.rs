@@ -737,3 +737,57 @@ fn a_symmetric_bound_is_the_looser_of_the_two_sides() {
         (ab.distance, ba.upper_bound)
     );
 }
+
+/// Hausdorff distances compare squared distances in the measured model's frame: models
+/// posed farther apart than `MAX_COORDINATE` are refused by name (once reported as a
+/// corrupt tree), and the distance just inside the limit is answered.
+#[test]
+fn models_beyond_reach_are_refused_by_name() {
+    use obbtree::query::MAX_COORDINATE;
+    let sphere = build(
+        &common::uv_sphere(1.0, 4, 6),
+        &BuildOptions::default(),
+        None,
+    )
+    .expect("builds");
+    let id = Pose::identity();
+    let options = HausdorffOptions {
+        symmetric: true,
+        ..HausdorffOptions::default()
+    };
+    let near = Pose::translation(0.5 * MAX_COORDINATE, 0.0, 0.0);
+    let h = hausdorff(&sphere, &id, &sphere, &near, &options).expect("answers");
+    assert!(
+        (h.distance - 0.5 * MAX_COORDINATE).abs() <= 1e-9 * MAX_COORDINATE,
+        "{h:?}"
+    );
+    let beyond = Pose::translation(2.0 * MAX_COORDINATE, 0.0, 0.0);
+    for (pose_a, pose_b, what) in [
+        (&id, &beyond, "model A vertex"),
+        (&beyond, &id, "model A vertex"),
+    ] {
+        let error = hausdorff(&sphere, pose_a, &sphere, pose_b, &options).expect_err("refused");
+        assert!(
+            matches!(error, QueryError::BadInput { what: w, .. } if w == what),
+            "{error}"
+        );
+        assert!(error.to_string().contains("in model B's frame"), "{error}");
+    }
+    let huge = BuildOptions {
+        precision: obbtree::real::Precision::F64,
+        scale: 2.0 * MAX_COORDINATE,
+        ..BuildOptions::default()
+    };
+    let huge = build(&common::uv_sphere(1.0, 4, 6), &huge, None).expect("builds");
+    let error = hausdorff(&sphere, &id, &huge, &id, &options).expect_err("refused");
+    assert!(
+        matches!(
+            error,
+            QueryError::BadInput {
+                what: "model B triangle",
+                ..
+            }
+        ),
+        "{error}"
+    );
+}

@@ -580,6 +580,14 @@ fn the_cli_answers_as_the_library() {
         every.extend(args);
         assert_bad_input(&obbtree(&every), needle);
     }
+    // A bad row of a file is named by its line, after the comment and the blank line.
+    let bad = dir.join("bad-rays.txt");
+    std::fs::write(&bad, "# ox oy oz dx dy dz\n0 0 0 1 0 0\n\n0 0 0 0 0 0\n").expect("writes");
+    let bad = bad.to_str().expect("a path");
+    assert_bad_input(
+        &obbtree(&["ray", cow_path.as_str(), "--rays", bad]),
+        &format!("{bad}: line 4: ray 1: direction must not be zero"),
+    );
 }
 
 /// `--threads` on the one-model commands picks how many threads answer, never what they

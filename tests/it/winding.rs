@@ -340,3 +340,45 @@ fn the_cli_answers_as_the_library() {
         assert_bad_input(&obbtree(&every), needle);
     }
 }
+
+/// Far from a model, and on a model whose moments overflow, winding numbers stay finite
+/// in every mode: the expansion is evaluated on the unit direction (no power of the
+/// distance is formed), a triangle's exact angle is taken again at unit scale when its
+/// cubes overflow, and a cluster whose moments overflowed is opened.
+#[test]
+fn far_points_and_huge_models_get_finite_winding_numbers() {
+    let accuracies = [
+        EXACT,
+        WindingOptions {
+            accuracy: WindingAccuracy::Bounded { tolerance: 1e-3 },
+        },
+        WindingOptions::default(),
+    ];
+    let cow = build(&common::cow(), &Default::default(), None).expect("builds");
+    let far: Vec<[f64; 3]> = [1e60, 1e120, obbtree::query::MAX_COORDINATE]
+        .iter()
+        .map(|&x| [x, 3.0, -x])
+        .collect();
+    for options in &accuracies {
+        let w = winding_numbers(&cow, &Pose::identity(), &far, options).expect("answers");
+        for (p, w) in far.iter().zip(&w) {
+            assert!(
+                w.value.abs() < 1e-100 && w.error_bound.is_finite(),
+                "{p:?}: {w:?}"
+            );
+        }
+    }
+    // A sphere 1e80 across: its moments' fourth powers overflow, not its coordinates.
+    let huge = obbtree::build::BuildOptions {
+        precision: obbtree::real::Precision::F64,
+        scale: 1e80,
+        ..Default::default()
+    };
+    let huge = build(&common::uv_sphere(1.0, 8, 12), &huge, None).expect("builds");
+    let points = [[0.0; 3], [3e80, 0.0, 0.0]];
+    for options in &accuracies {
+        let w = winding_numbers(&huge, &Pose::identity(), &points, options).expect("answers");
+        assert!((w[0].value - 1.0).abs() < 1e-9, "{:?}", w[0]);
+        assert!(w[1].value.abs() < 1e-9, "{:?}", w[1]);
+    }
+}

@@ -22,7 +22,7 @@ pub(in crate::query) mod ray;
 
 use super::engine::triangle;
 use super::triangle::Triangle;
-use super::{QueryError, Side};
+use super::{source_id, QueryError, Side, MAX_COORDINATE, WITHIN_REACH};
 use crate::arr3;
 use crate::bv::BoundingVolume;
 use crate::real::Real;
@@ -154,6 +154,9 @@ pub(in crate::query) struct SurfaceIndex {
     triangles: Vec<Triangle>,
     /// Each one's stored face index, for its input id.
     faces: Vec<u32>,
+    /// The first stored face with a coordinate beyond [`MAX_COORDINATE`], and that
+    /// coordinate's magnitude.
+    beyond_reach: Option<(u32, f64)>,
 }
 
 impl SurfaceIndex {
@@ -172,6 +175,25 @@ impl SurfaceIndex {
     #[inline(always)]
     pub(in crate::query) fn triangle(&self, i: usize) -> Option<(&Triangle, u32)> {
         Some((self.triangles.get(i)?, *self.faces.get(i)?))
+    }
+
+    /// The error naming the first triangle (by its input id) with a coordinate beyond
+    /// [`MAX_COORDINATE`], for the queries that measure squared distances to the model.
+    /// `what` names such a triangle ("model triangle").
+    pub(in crate::query) fn check_reach<B: BoundingVolume>(
+        &self,
+        tree: &TreeView<'_, B>,
+        what: &'static str,
+    ) -> Result<(), QueryError> {
+        match self.beyond_reach {
+            Some((face, value)) => Err(QueryError::BadInput {
+                what,
+                index: source_id(tree, face, Side::A)? as usize,
+                requirement: WITHIN_REACH,
+                value,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// The index of `tree`'s triangles. O(n log n).
@@ -212,10 +234,15 @@ impl SurfaceIndex {
             .iter()
             .filter_map(|p| stored.get(p.face as usize).copied())
             .collect();
+        let beyond_reach = (0..count).zip(&stored).find_map(|(face, t)| {
+            let largest = t.iter().map(|p| p.amax()).fold(0.0, f64::max);
+            (!(largest <= MAX_COORDINATE)).then_some((face, largest))
+        });
         Ok(SurfaceIndex {
             nodes,
             triangles,
             faces: prims.iter().map(|p| p.face).collect(),
+            beyond_reach,
         })
     }
 }
