@@ -39,7 +39,7 @@ pub enum PoseError {
         value: f64,
     },
     /// The rotation is not orthonormal within [`ORTHONORMAL_TOLERANCE`].
-    #[error("rotation is not orthonormal: |RᵀR − I| reaches {deviation:.3e} (tolerance {ORTHONORMAL_TOLERANCE:e}; --orthonormalize takes the nearest rotation)")]
+    #[error("rotation is not orthonormal: |RᵀR − I| reaches {deviation:.3e} (tolerance {ORTHONORMAL_TOLERANCE:e}; the orthonormalize option takes the nearest rotation)")]
     NotOrthonormal {
         /// Largest entry of `|RᵀR − I|`.
         deviation: f64,

@@ -57,8 +57,8 @@ pub struct BuildOptions {
     /// axes (CAD) have many nodes whose covariance frame is tilted against their flat sides;
     /// on them the model's axes make far fewer node pairs and box tests, for a little more
     /// build time (the figures are in docs/results). Off (with
-    /// [`BuildOptions::hull_min_faces`] 1 and [`BuildOptions::hull_max_points`] `u32::MAX`)
-    /// gives §3.4 exactly.
+    /// [`BuildOptions::hull_min_faces`] 1, [`BuildOptions::hull_max_points`] `u32::MAX`
+    /// and [`BuildOptions::split_by_volume`] off) gives §3.4 exactly.
     pub model_axes: bool,
     /// Split each node along whichever of its box's three axes divides it into the least
     /// total volume, measured along those axes; the first axis (greatest spread) unless

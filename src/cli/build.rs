@@ -81,7 +81,8 @@ pub struct TreeArgs {
     /// With --fit hull, the fewest triangles (at least 1) a node needs to be fitted to its
     /// convex hull; smaller nodes are fitted to their triangles, which is as tight there
     /// and much cheaper. 1 fits every node to its hull (over every vertex too with
-    /// --hull-max-points all and --model-axes no: the dissertation's §3.4 exactly)
+    /// --hull-max-points all, --model-axes no and --split-by-volume no: the dissertation's
+    /// §3.4 exactly)
     /// [default: 512].
     #[arg(long, value_name = "N")]
     pub hull_min_faces: Option<u32>,

@@ -61,7 +61,8 @@ const CELL: [(&str, &[u8]); 11] = [
 ///
 /// Builds a tree with each bounding volume, writes the files into a directory, opens them
 /// memory-mapped, verifies them, prints what it built, then runs collision, distance and
-/// span queries between two posed copies.
+/// span queries between two posed copies, and last the shipped robot cell's scene, fast and
+/// then checked against the naive run.
 #[derive(Args, Debug)]
 pub struct DemoArgs {
     /// Keep the built files in this directory (default: a temporary one, removed at the end).
@@ -77,12 +78,29 @@ pub fn run(args: &DemoArgs) -> Result<(), Failure> {
             true,
         ),
     };
-    std::fs::create_dir_all(&dir).with_context(|| dir.display())?;
+    // Only the directory itself is made: a mistyped parent is reported, not created.
+    match std::fs::create_dir(&dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && !dir.is_dir() => {
+            return Err(Failure::msg(format!(
+                "{}: exists and is not a directory",
+                dir.display()
+            )))
+        }
+        Err(e) if e.kind() != std::io::ErrorKind::AlreadyExists => {
+            return Err(Failure::from(e).context(format!("{}: cannot create", dir.display())))
+        }
+        _ => {}
+    }
     let result = run_in(&dir);
     if temporary {
         let _ = std::fs::remove_dir_all(&dir);
+        result?;
+        out!("inspect a file with: obbtree info <file>   (run with --out DIR to keep the files)")?;
+        return Ok(());
     }
-    result
+    result?;
+    out!("inspect a file with: obbtree info <file>")?;
+    Ok(())
 }
 
 fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
@@ -133,7 +151,6 @@ fn run_in(dir: &std::path::Path) -> Result<(), Failure> {
     }
     run_queries(&dir.join("cow-obb.obbt"))?;
     run_cell(&dir.join("cell"))?;
-    out!("inspect a file with: obbtree info <file>   (run with --out DIR to keep the files)")?;
     Ok(())
 }
 

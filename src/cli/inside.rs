@@ -71,7 +71,12 @@ pub fn run(args: &InsideArgs) -> Result<(), Failure> {
     let points = &rows.values;
     let accuracy = match args.tolerance {
         Some(0.0) => WindingAccuracy::Exact,
-        Some(tolerance) => WindingAccuracy::Bounded { tolerance },
+        Some(tolerance) if tolerance > 0.0 => WindingAccuracy::Bounded { tolerance },
+        Some(tolerance) => {
+            return Err(Failure::msg(format!(
+                "--tolerance must be at least 0 (0 is exact), got {tolerance}"
+            )))
+        }
         None => WindingAccuracy::Beta { beta: args.beta },
     };
     let model = open_model(&args.model, &args.tree)?;

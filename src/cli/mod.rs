@@ -20,6 +20,7 @@ mod scene;
 mod verify;
 
 use clap::{Parser, Subcommand};
+use obbtree::query::QueryError;
 use obbtree::scene::SceneError;
 use std::error::Error;
 use std::fmt::{self, Display};
@@ -105,10 +106,20 @@ impl<E: Error + Send + Sync + 'static> From<E> for Failure {
 /// its cause to `source()`, so no text appears twice; a [`SceneError`] is the exception
 /// its doc states (its message is complete, located in the scene file, with the cause's
 /// text), so the chain stops there.
+///
+/// A query's option is named by its flag (`--rel-err`), not its field (`rel_err`): each
+/// option of the library's queries is a flag of the same name here.
 impl Display for Failure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut error: &(dyn Error + 'static) = &*self.error;
-        write!(f, "{error}")?;
+        match error.downcast_ref::<QueryError>() {
+            Some(e @ QueryError::BadOption { name, .. }) => {
+                let text = e.to_string();
+                let rest = text.strip_prefix(name).unwrap_or(&text);
+                write!(f, "--{}{rest}", name.replace('_', "-"))?;
+            }
+            _ => write!(f, "{error}")?,
+        }
         while let (None, Some(cause)) = (error.downcast_ref::<SceneError>(), error.source()) {
             write!(f, ": {cause}")?;
             error = cause;

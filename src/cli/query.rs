@@ -27,10 +27,6 @@ pub struct QueryInputs {
     pub b: PathBuf,
     #[command(flatten)]
     pub poses: PoseArgs,
-    /// Which tree to descend when both can be: larger diameter, volume or area, or always
-    /// A or B.
-    #[arg(long, value_enum, default_value_t = RuleArg::Diameter)]
-    pub rule: RuleArg,
     /// Print JSON (one object; a batch prints JSON lines unless --csv).
     #[arg(long, conflicts_with = "csv")]
     pub json: bool,
@@ -57,6 +53,16 @@ pub struct QueryInputs {
         next_help_heading = "Mesh inputs (built in memory; not for .obbt inputs)"
     )]
     pub tree: TreeArgs,
+}
+
+/// The descent rule of the queries that descend both trees (not `hausdorff`, which
+/// measures A's surface against B's as a whole).
+#[derive(Args, Debug)]
+pub struct DescentArgs {
+    /// Which tree to descend when both can be: larger diameter, volume or area, or always
+    /// A or B.
+    #[arg(long, value_enum, default_value_t = RuleArg::Diameter)]
+    pub rule: RuleArg,
 }
 
 /// `--rule` values.
@@ -120,6 +126,8 @@ pub struct CollideArgs {
     #[arg(long, value_enum, default_value_t = BoxTestArg::Sat)]
     pub box_test: BoxTestArg,
     #[command(flatten)]
+    pub descent: DescentArgs,
+    #[command(flatten)]
     pub inputs: QueryInputs,
 }
 
@@ -140,7 +148,7 @@ pub struct DistanceArgs {
         allow_negative_numbers = true
     )]
     pub rel_err: f64,
-    /// Absolute error allowed, model units (>= 0).
+    /// Absolute error allowed, world units (>= 0).
     #[arg(
         long,
         default_value_t = 0.0,
@@ -152,6 +160,8 @@ pub struct DistanceArgs {
     #[arg(long, value_name = "T", allow_negative_numbers = true, conflicts_with_all = ["rel_err", "abs_err"])]
     pub tolerance: Option<f64>,
     #[command(flatten)]
+    pub descent: DescentArgs,
+    #[command(flatten)]
     pub inputs: QueryInputs,
 }
 
@@ -160,6 +170,8 @@ pub struct DistanceArgs {
 /// Example: obbtree span a.obbt b.obbt --json
 #[derive(Args, Debug)]
 pub struct SpanArgs {
+    #[command(flatten)]
+    pub descent: DescentArgs,
     #[command(flatten)]
     pub inputs: QueryInputs,
 }
@@ -176,8 +188,6 @@ pub struct SpanArgs {
 /// Example: obbtree hausdorff simplified.obbt original.obbt --rel-err 0.001
 #[derive(Args, Debug)]
 pub struct HausdorffArgs {
-    #[command(flatten)]
-    pub inputs: QueryInputs,
     /// Relative error allowed: the answer h and the true h* satisfy h <= h* <= h (1 + E).
     #[arg(
         long,
@@ -197,6 +207,9 @@ pub struct HausdorffArgs {
     /// Also measure from B to A and answer the larger: the symmetric Hausdorff distance.
     #[arg(long)]
     pub symmetric: bool,
+    // Last: its mesh flags' heading would also take the flags after it.
+    #[command(flatten)]
+    pub inputs: QueryInputs,
 }
 
 /// Whether an input is to be read as a tree: it starts with the `.obbt` signature, or it
@@ -425,7 +438,7 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
     let (a, b) = open_pair(&args.inputs)?;
     let options = CollideOptions {
         first_contact: args.first,
-        rule: args.inputs.rule.rule(),
+        rule: args.descent.rule.rule(),
         box_test: match args.box_test {
             BoxTestArg::Sat => BoxTest::SeparatingAxes,
             BoxTestArg::Rewrapped => BoxTest::Rewrapped,
@@ -511,7 +524,7 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
 
 pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
     let (a, b) = open_pair(&args.inputs)?;
-    let rule = args.inputs.rule.rule();
+    let rule = args.descent.rule.rule();
     let options = DistanceOptions {
         rel_err: args.rel_err,
         abs_err: args.abs_err,
@@ -632,7 +645,7 @@ pub fn hausdorff(args: &HausdorffArgs) -> Result<(), Failure> {
 pub fn span(args: &SpanArgs) -> Result<(), Failure> {
     let (a, b) = open_pair(&args.inputs)?;
     let options = SpanOptions {
-        rule: args.inputs.rule.rule(),
+        rule: args.descent.rule.rule(),
     };
     let columns = csv_columns(&["/span", "/tri_a", "/tri_b"]);
     let repeat = args.inputs.repeat;

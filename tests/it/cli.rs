@@ -197,6 +197,29 @@ fn demo_runs() {
         text.contains("5804 triangles") && text.contains("file == memory: yes"),
         "{text}"
     );
+    assert!(text
+        .trim_end()
+        .ends_with("(run with --out DIR to keep the files)"));
+    // With --out the files stay, and the last line no longer offers it; the directory is
+    // made, never its missing parents, and a file in its place is refused.
+    let dir = scratch("demo");
+    let kept = dir.join("kept");
+    let o = obbtree(&["demo", "--out", kept.to_str().expect("a path")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("--out"));
+    assert!(kept.join("cow-obb.obbt").is_file());
+    let orphan = dir.join("missing").join("out");
+    assert_bad_input(
+        &obbtree(&["demo", "--out", orphan.to_str().expect("a path")]),
+        "out: cannot create",
+    );
+    assert!(!dir.join("missing").exists());
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").expect("writes");
+    assert_bad_input(
+        &obbtree(&["demo", "--out", file.to_str().expect("a path")]),
+        "a-file: exists and is not a directory",
+    );
 }
 
 const SHIFT_X: &str = "1,0,0,0,1,0,0,0,1,0.2,0,0";
@@ -369,7 +392,10 @@ fn malformed_poses_and_mismatched_trees_are_exit_1() {
         &obbtree(&["distance", f, f, "--pose-b", "1,0,0,0,1,0,0,0,1,NaN,0,0"]),
         "not finite",
     );
-    assert_bad_input(&obbtree(&["distance", f, f, "--rel-err", "-1"]), "rel_err");
+    assert_bad_input(
+        &obbtree(&["distance", f, f, "--rel-err", "-1"]),
+        "--rel-err must be",
+    );
     let aabb = dir.join("aabb.obbt");
     build(&aabb, &["--bv", "aabb"]);
     assert_bad_input(&obbtree(&["span", f, aabb.to_str().unwrap()]), "differ");

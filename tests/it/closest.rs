@@ -255,7 +255,7 @@ fn the_cli_answers_as_the_library() {
         (vec!["--point", "0,0,nan"], "finite"),
         (
             vec!["--point", "0,0,0", "--max-distance", "-1"],
-            "max_distance",
+            "--max-distance must be",
         ),
         (vec![], "--points"),
     ] {

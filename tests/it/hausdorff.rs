@@ -380,7 +380,23 @@ fn the_cli_answers_as_the_library() {
     assert_eq!(line["direction"], direction);
     assert!(line["upper_bound"].as_f64().expect("a number") >= printed);
     let o = obbtree(&["hausdorff", &cow, &cow, "--rel-err", "-0.5"]);
-    assert_bad_input(&o, "rel_err must be finite and at least 0, got -0.5");
+    assert_bad_input(&o, "--rel-err must be finite and at least 0, got -0.5");
+    // The query's own flags come before the mesh-build heading, and no descent rule is
+    // offered: the query measures A's surface against B's as a whole.
+    let o = obbtree(&["hausdorff", "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout);
+    let heading = help.find("Mesh inputs").expect("the mesh heading");
+    for flag in ["--rel-err", "--abs-err", "--symmetric"] {
+        assert!(
+            help.find(flag).is_some_and(|at| at < heading),
+            "{flag}: {help}"
+        );
+    }
+    assert!(!help.contains("--rule"), "{help}");
+    assert!(obbtree(&["collide", "--help"])
+        .stdout
+        .windows(6)
+        .any(|w| w == b"--rule"));
 }
 
 /// The bundled cow and a sphere of radius 0.2 (80 triangles), default trees.

@@ -17,6 +17,7 @@ mod contact_work;
 mod corruption;
 mod dev_config;
 mod distance_work;
+mod doc_examples;
 mod doc_links;
 mod encoding;
 mod experiment_cli;

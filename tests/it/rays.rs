@@ -573,7 +573,10 @@ fn the_cli_answers_as_the_library() {
             "ray 0: direction must not be zero",
         ),
         (vec!["--ray", "0,0,nan,1,0,0"], "finite"),
-        (vec!["--ray", "0,0,0,1,0,0", "--t-max", "0"], "t_max"),
+        (
+            vec!["--ray", "0,0,0,1,0,0", "--t-max", "0"],
+            "--t-max must be",
+        ),
         (vec![], "--rays"),
     ] {
         let mut every = vec!["ray", cow_path.as_str()];

@@ -331,8 +331,11 @@ fn the_cli_answers_as_the_library() {
     for (args, needle) in [
         (vec!["--point", "1,2"], "--point"),
         (vec!["--point", "0,0,nan"], "query point 0"),
-        (vec!["--point", "0,0,0", "--beta", "0.5"], "beta"),
-        (vec!["--point", "0,0,0", "--tolerance", "-1"], "tolerance"),
+        (vec!["--point", "0,0,0", "--beta", "0.5"], "--beta must be"),
+        (
+            vec!["--point", "0,0,0", "--tolerance", "-1"],
+            "--tolerance must be at least 0 (0 is exact), got -1",
+        ),
         (vec![], "--points"),
     ] {
         let mut every = vec!["inside", cow_path.as_str()];
