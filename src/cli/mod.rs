@@ -8,6 +8,7 @@ mod experiment;
 mod files;
 mod generate;
 mod info;
+mod input;
 mod inside;
 mod plot;
 mod poses;

@@ -1,6 +1,7 @@
 //! Poses from the command line and from pose files, in any [`PoseFormat`], optionally
 //! repaired to the nearest rotation.
 
+use super::input::{input_lines, parse_numbers, read_input};
 use super::{Failure, WithContext};
 use clap::{Args, ValueEnum};
 use obbtree::query::{ParsedPose, Pose, PoseFormat, ORTHONORMAL_TOLERANCE};
@@ -16,10 +17,10 @@ pub struct PoseArgs {
     /// Pose of B, as --pose-a.
     #[arg(long, value_name = "P", allow_hyphen_values = true)]
     pub pose_b: Option<String>,
-    /// A batch of poses: each non-empty line holds pose A then pose B (24 numbers in the
-    /// default format) separated by spaces or commas. Prints one JSON object per pose, in
-    /// input order, each with "pose": its index from 0 (blank lines do not count); queries
-    /// run in parallel.
+    /// A batch of poses, a file (`-` for stdin): each line holds pose A then pose B (24
+    /// numbers in the default format) separated by spaces or commas; blank lines and lines
+    /// starting with `#` are skipped. Prints one JSON object per pose, in input order, each
+    /// with "pose": its index from 0 (skipped lines do not count); queries run in parallel.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["pose_a", "pose_b"])]
     pub poses: Option<PathBuf>,
     /// How the numbers of a pose are laid out: rt = rotation row-major then translation
@@ -94,18 +95,6 @@ impl PoseFormatArg {
             PoseFormatArg::Matrix4 => PoseFormat::Matrix4,
         }
     }
-}
-
-/// Numbers separated by commas and/or white space; `what` names the source in errors.
-pub fn parse_numbers(text: &str, what: &str) -> Result<Vec<f64>, Failure> {
-    text.split(|c: char| c == ',' || c.is_whitespace())
-        .filter(|t| !t.is_empty())
-        .enumerate()
-        .map(|(i, t)| {
-            t.parse::<f64>()
-                .map_err(|_| Failure::msg(format!("{what}: value {i} ({t:?}) is not a number")))
-        })
-        .collect()
 }
 
 /// The pose given by `flag` (`text`, in `format`; the identity without it), its repair
@@ -194,20 +183,12 @@ impl PoseArgs {
         let Some(path) = &self.poses else {
             return Ok(None);
         };
-        let text = std::fs::read_to_string(path).with_context(|| path.display())?;
+        let (shown, text) = read_input(path)?;
         let per_pose = self.pose_format.format().numbers();
         let mut repairs = Repairs::default();
         let mut out = Vec::new();
-        for (line_no, line) in text.lines().enumerate() {
-            if line.trim().is_empty() {
-                continue;
-            }
-            let what = format!(
-                "{}: line {} (pose {})",
-                path.display(),
-                line_no + 1,
-                out.len()
-            );
+        for (line_no, line) in input_lines(&text) {
+            let what = format!("{shown}: line {line_no} (pose {})", out.len());
             let values = parse_numbers(line, &what)?;
             let Some((a, b)) = values
                 .split_at_checked(per_pose)
@@ -231,7 +212,12 @@ impl PoseArgs {
             let b = pose(b, "B")?;
             out.push((a, b));
         }
-        repairs.report(&path.display().to_string());
+        if out.is_empty() {
+            return Err(Failure::msg(format!(
+                "{shown}: no poses (lines of pose A then pose B)"
+            )));
+        }
+        repairs.report(&shown);
         Ok(Some(out))
     }
 }

@@ -1,11 +1,10 @@
 //! Query inputs given as rows of numbers: one on the command line, or a file or stdin of
 //! lines (what `closest` and `ray` read).
 
-use super::poses::parse_numbers;
-use super::{Failure, WithContext};
+use super::input::{input_lines, parse_numbers, read_input};
+use super::Failure;
 use clap::Args;
 use obbtree::query::QueryError;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Rows of `N` numbers read by [`numeric_rows`], with where each one was read.
@@ -69,30 +68,12 @@ pub fn numeric_rows<const N: usize>(
             lines: Vec::new(),
         }),
         (None, Some(path)) => {
-            let stdin = path.as_os_str() == "-";
-            let shown = if stdin {
-                "<stdin>".to_string()
-            } else {
-                path.display().to_string()
-            };
-            let mut text = String::new();
-            if stdin {
-                std::io::stdin()
-                    .read_to_string(&mut text)
-                    .with_context(|| format!("{shown}: cannot read"))?;
-            } else {
-                text = std::fs::read_to_string(path)
-                    .with_context(|| format!("{shown}: cannot read"))?;
-            }
+            let (shown, text) = read_input(path)?;
             let (mut values, mut lines) = (Vec::new(), Vec::new());
-            for (line, content) in text.lines().enumerate() {
-                let content = content.trim();
-                if content.is_empty() || content.starts_with('#') {
-                    continue;
-                }
-                let at = || format!("{shown}: line {}", line + 1);
+            for (line, content) in input_lines(&text) {
+                let at = || format!("{shown}: line {line}");
                 values.push(row(parse_numbers(content, &at())?, &at)?);
-                lines.push(line + 1);
+                lines.push(line);
             }
             if values.is_empty() {
                 return Err(Failure::msg(format!("{shown}: no rows of {names}")));

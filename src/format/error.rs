@@ -84,9 +84,10 @@ pub enum FormatError {
 
 /// A file that could not be opened: its path and why.
 ///
-/// The message is `path: cause`, the cause's text included (callers that keep only the
-/// message, such as a scene's error lines, show it), so `source()` does not return the
-/// cause too: a printer of the whole chain would show it twice. The cause stays in the
+/// The message is `path: cause` (`path: cannot read: cause` for the operating system's, as
+/// the mesh loaders say), the cause's text included (callers that keep only the message,
+/// such as a scene's error lines, show it), so `source()` does not return the cause too:
+/// a printer of the whole chain would show it twice. The cause stays in the
 /// variant's `source` field. (thiserror would return a field named `source` from
 /// `source()`, hence the hand-written impls.)
 #[derive(Debug)]
@@ -111,7 +112,9 @@ pub enum OpenError {
 impl fmt::Display for OpenError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            OpenError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            OpenError::Io { path, source } => {
+                write!(f, "{}: cannot read: {source}", path.display())
+            }
             OpenError::Format { path, source } => write!(f, "{}: {source}", path.display()),
         }
     }

@@ -358,11 +358,50 @@ fn pose_batches_print_one_line_per_pose_in_order() {
         let single: serde_json::Value = serde_json::from_slice(&single.stdout).unwrap();
         assert_eq!(line["contacts"], single["contacts"], "pose {k}");
     }
-    // Errors name the line (from 1) and the pose (from 0, as the "pose" field does).
-    std::fs::write(&poses, format!("{identity} {identity}\n\n1 2 3\n")).unwrap();
+    // Errors name the line (from 1) and the pose (from 0, as the "pose" field does);
+    // comments are skipped as blank lines are.
+    std::fs::write(
+        &poses,
+        format!("# A then B\n{identity} {identity}\n\n1 2 3\n"),
+    )
+    .unwrap();
     assert_bad_input(
         &obbtree(&["collide", f, f, "--poses", poses.to_str().unwrap()]),
-        "poses.txt: line 3 (pose 1): expected 24 numbers",
+        "poses.txt: line 4 (pose 1): expected 24 numbers",
+    );
+    // A file with no poses is an error, not an empty answer; `-` reads standard input,
+    // as --points and --rays do.
+    std::fs::write(&poses, "# nothing yet\n\n").unwrap();
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--poses", poses.to_str().unwrap()]),
+        "poses.txt: no poses",
+    );
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_obbtree"))
+        .args(["collide", f, f, "--poses", "-", "--first"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stdin = child.stdin.take().unwrap();
+    std::io::Write::write_all(
+        &mut { stdin },
+        format!("{identity} {identity}\n").as_bytes(),
+    )
+    .unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success());
+    let line: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (&line["pose"], &line["colliding"]),
+        (&0.into(), &true.into())
+    );
+    assert_bad_input(
+        &obbtree(&["collide", f, f, "--poses", "missing.txt"]),
+        "missing.txt: cannot read: ",
+    );
+    assert_bad_input(
+        &obbtree(&["collide", "missing.obbt", f]),
+        "missing.obbt: cannot read: ",
     );
 }
 
