@@ -216,9 +216,18 @@ class ClosestResult:
 _FEATURES = np.array(["face", "edge", "vertex", ""])
 
 
+def _numbers(name: str, value: Any) -> np.ndarray:
+    """``value`` as a float64 array, or ``OptionError`` naming ``name`` when NumPy cannot
+    make one (text, ragged rows)."""
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise OptionError(f"{name} must be numbers in an (N, 3) array: {e}") from e
+
+
 def _point_rows(points: Any) -> np.ndarray:
     """``points`` as a contiguous (N, 3) float64 array; one point (3,) is one row."""
-    array = np.asarray(points, dtype=np.float64)
+    array = _numbers("points", points)
     if array.shape == (3,):
         array = array.reshape(1, 3)
     if array.ndim != 2 or array.shape[1] != 3:
@@ -322,8 +331,8 @@ def ray(
     a zero or non-finite direction (naming the ray), a ``t_max`` not above 0 or an unknown
     mode; ``PoseError`` for a pose that is not a rigid motion.
     """
-    o = np.asarray(origins, dtype=np.float64)
-    d = np.asarray(directions, dtype=np.float64)
+    o = _numbers("origins", origins)
+    d = _numbers("directions", directions)
     for name, a in (("origins", o), ("directions", d)):
         if not (a.shape == (3,) or (a.ndim == 2 and a.shape[1] == 3)):
             raise OptionError(f"{name} must be an (N, 3) array or one row (3,), got shape {a.shape}")

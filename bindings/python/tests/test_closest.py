@@ -56,3 +56,13 @@ def test_bad_points_raise():
         obbtree.closest(tree, np.eye(4), [[0.0, 0.0, 0.0]], max_distance=0.0)
     with pytest.raises(obbtree.PoseError):
         obbtree.closest(tree, 2 * np.eye(4), [[0.0, 0.0, 0.0]])
+    # What NumPy cannot make numbers of is named too, not left to NumPy's own error.
+    with pytest.raises(obbtree.OptionError, match="^points must be numbers"):
+        obbtree.closest(tree, np.eye(4), [[0.0, 0.0, 0.0], [1.0, 2.0]])
+    with pytest.raises(obbtree.OptionError, match="^origins must be numbers"):
+        obbtree.ray(tree, np.eye(4), "abc", [0.0, 0.0, 1.0])
+    with pytest.raises(obbtree.OptionError, match="^points must be numbers"):
+        obbtree.winding_number(tree, np.eye(4), [["a", "b", "c"]])
+    # Squared distances would overflow beyond 1e150: refused by name, not NaN or nothing.
+    with pytest.raises(obbtree.OptionError, match=r"query point 1: coordinates must be within ±1e150"):
+        obbtree.closest(tree, np.eye(4), [[0.0, 0.0, 0.0], [2e150, 0.0, 0.0]])
