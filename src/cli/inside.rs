@@ -18,10 +18,12 @@ use std::path::PathBuf;
 /// The winding number is 1 inside a closed outward-facing surface and 0 outside; for a
 /// surface with holes, duplicate or self-intersecting triangles it lies between, and a
 /// point is inside where it is above 0.5. Far clusters of triangles are summed by their
-/// moments: by default those seen from more than --beta times their radius (fast, error
-/// measured small); with --tolerance each value is proven within it of the exact sum,
-/// and --tolerance 0 sums every triangle. Prints, per point, the winding number, inside or
-/// not, and with --distance the signed distance (negative inside).
+/// moments: by default those seen from more than --beta times their radius (fast; the
+/// error measured against the exact sum is small, but the bound printed as error_bound is
+/// the proven one, often far larger); with --tolerance each value is proven within it of
+/// the exact sum, and --tolerance 0 sums every triangle. Prints, per point, the winding
+/// number, inside or not, the error bound, and with --distance the signed distance
+/// (negative inside).
 ///
 /// Example: obbtree inside part.obbt --point 0.1,0.2,0.3
 ///

@@ -159,6 +159,16 @@ pub struct DistanceArgs {
     /// Only decide whether the distance is below T.
     #[arg(long, value_name = "T", allow_negative_numbers = true, conflicts_with_all = ["rel_err", "abs_err"])]
     pub tolerance: Option<f64>,
+    /// Only look for a distance below D (world units, >= 0): volume pairs at least D apart
+    /// are never opened, and models at least D apart print "beyond D" (JSON: "distance":
+    /// null, "beyond": D).
+    #[arg(
+        long,
+        value_name = "D",
+        allow_negative_numbers = true,
+        conflicts_with = "tolerance"
+    )]
+    pub max_distance: Option<f64>,
     #[command(flatten)]
     pub descent: DescentArgs,
     #[command(flatten)]
@@ -528,6 +538,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
     let options = DistanceOptions {
         rel_err: args.rel_err,
         abs_err: args.abs_err,
+        max_distance: args.max_distance.unwrap_or(f64::INFINITY),
         rule,
         ..DistanceOptions::default()
     };
@@ -576,9 +587,17 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
         }
         let (r, seconds) = median_time(repeat, || pair.distance(pa, pb, &options))?;
         // Without a maximum distance every query finds a closest pair.
-        let w = r
-            .closest
-            .ok_or_else(|| Failure::msg("no triangle pair reached"))?;
+        let Some(w) = r.closest else {
+            let beyond = options.max_distance;
+            let value = json!({"distance": null, "beyond": beyond, "point_a": null,
+                "point_b": null, "tri_a": null, "tri_b": null,
+                "stats": work_json(&r.work), "seconds": seconds});
+            let work = work_text(&r.work);
+            return Ok((
+                value,
+                format!("distance: beyond {beyond} ({work}) in {seconds:.6} s"),
+            ));
+        };
         let value = witness_json("distance", &w, &r.work, seconds);
         let text = format!(
             "distance: {} between triangle {} of A at {:?} and triangle {} of B at {:?} ({}) in {seconds:.6} s",

@@ -1140,3 +1140,36 @@ fn yes_no_flag_changes_the_tree(flag: &str) {
     assert!(stderr(&o).contains(flag), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+/// `distance --max-distance D` answers as the library's maximum does: models at least D
+/// apart print "beyond D" after one volume test, nearer ones the same distance as without.
+#[test]
+fn distance_with_a_maximum_prints_beyond_it() {
+    let dir = scratch("max-distance");
+    let out = dir.join("cow.obbt");
+    build(&out, &[]);
+    let f = out.to_str().unwrap();
+    let apart = "1,0,0,0,1,0,0,0,1,2,0,0";
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["distance", f, f, "--pose-b", apart, "--json"];
+        args.extend(extra);
+        let o = obbtree(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let beyond = json(&["--max-distance", "0.5"]);
+    assert_eq!(beyond["distance"], serde_json::Value::Null, "{beyond}");
+    assert_eq!(beyond["beyond"], 0.5);
+    assert_eq!(beyond["stats"]["bv_tests"], 1);
+    let exact = json(&[]);
+    assert_eq!(
+        json(&["--max-distance", "5"])["distance"],
+        exact["distance"]
+    );
+    let text = obbtree(&["distance", f, f, "--pose-b", apart, "--max-distance", "0.5"]);
+    assert!(String::from_utf8_lossy(&text.stdout).starts_with("distance: beyond 0.5 ("));
+    assert_bad_input(
+        &obbtree(&["distance", f, f, "--max-distance", "-1"]),
+        "--max-distance must be",
+    );
+}
