@@ -780,9 +780,10 @@ pub fn span(
 /// its closest point on B; with `symmetric`, the larger of that and the reverse.
 ///
 /// rel_err, abs_err: the error allowed, `h <= h* <= max(h (1 + rel_err), h + abs_err)`
-/// for the answer h and the true h*; with both 0 (the default) exact to f64 rounding,
-/// except where the farthest point lies where two triangles of B are equally near (then
-/// `upper_bound` says how close).
+/// for the answer h and the true h*; with both 0 (the default) exact to f64 rounding
+/// wherever the bounds close, which they do not quite where B curves or where the two
+/// surfaces nearly coincide, triangulated differently (then `upper_bound` says how
+/// close).
 ///
 /// Returns a `HausdorffResult` (distance, upper_bound, direction, point_a, point_b, tri_a,
 /// tri_b, work). Raises `obbtree.OptionError` (a ValueError) for a negative or non-finite
