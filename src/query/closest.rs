@@ -3,7 +3,7 @@
 
 use super::index::SurfaceIndex;
 use super::triangle::Feature;
-use super::{check_points, QueryError, Work};
+use super::{check_points, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
 use crate::format::{ObbtFile, TreeVisitor};
 use crate::pose::Pose;
@@ -71,7 +71,9 @@ impl ClosestResult {
 ///
 /// # Errors
 ///
-/// - [`QueryError::BadInput`] for a query point with a non-finite coordinate,
+/// - [`QueryError::BadInput`] for a query point with a non-finite coordinate, or one
+///   beyond [`MAX_COORDINATE`](super::MAX_COORDINATE) in the model's frame ("query
+///   point"), or a model triangle beyond it ("model triangle");
 ///   [`QueryError::BadOption`] for a `max_distance` that is not greater than 0.
 /// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
 ///
@@ -118,7 +120,7 @@ pub fn closest_points(
             // World to model: the world frame posed in the model's.
             let to_model = Pose::relative(self.pose, &Pose::identity());
             let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
-            index.check_reach(&tree, "model triangle")?;
+            index.check_reach(&tree, Side::A, "model triangle")?;
             // Runs of points in input order, each point's descent seeded with the triangle
             // its predecessor in the run found: fixed runs keep the answers independent of
             // the thread count. One heap per worker, reused point after point.

@@ -135,6 +135,9 @@ const FINEST: f64 = 1.0 / (1u64 << 24) as f64;
 /// # Errors
 ///
 /// - [`QueryError::BadOption`] for a negative or non-finite `rel_err` or `abs_err`.
+/// - [`QueryError::BadInput`] for a vertex of one model posed beyond
+///   [`MAX_COORDINATE`](super::MAX_COORDINATE) in the other's frame ("model A vertex"), or a
+///   triangle beyond it in its own ("model B triangle"), before any search.
 /// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
 ///
 /// # Examples
@@ -173,13 +176,17 @@ pub fn hausdorff(
             .filter(|w| w.direction == direction)
             .map(|w| (w.point, w.triangle))
     };
-    let ab = one_sided(
-        (a, pose_a),
-        (b, pose_b),
-        Side::B,
-        options,
-        seed(HausdorffDirection::AToB),
-    )?;
+    // Every refusal before any search: each direction's vertices and the model measured.
+    let from_a = flatten((a, pose_a), pose_b, Side::B, seed(HausdorffDirection::AToB))?;
+    check_model_reach(b, Side::B)?;
+    let from_b = if options.symmetric {
+        let from_b = flatten((b, pose_b), pose_a, Side::A, seed(HausdorffDirection::BToA))?;
+        check_model_reach(a, Side::A)?;
+        Some(from_b)
+    } else {
+        None
+    };
+    let ab = one_sided(&from_a, pose_a, (b, pose_b), options)?;
     let forward = HausdorffResult {
         distance: ab.distance,
         upper_bound: ab.upper_bound,
@@ -195,16 +202,11 @@ pub fn hausdorff(
         },
         work: ab.work,
     };
-    if !options.symmetric {
+    let Some(from_b) = from_b else {
         return Ok(forward);
-    }
-    let ba = one_sided(
-        (b, pose_b),
-        (a, pose_a),
-        Side::A,
-        options,
-        seed(HausdorffDirection::BToA),
-    )?;
+    };
+    drop(from_a);
+    let ba = one_sided(&from_b, pose_b, (a, pose_a), options)?;
     let mut work = ab.work;
     work += ba.work;
     let upper_bound = ab.upper_bound.max(ba.upper_bound);
@@ -246,15 +248,50 @@ struct OneSided {
     work: Work,
 }
 
-/// h(from, to), its search started from `seed` (a point of `from` in its model frame, and
-/// its triangle's input id) when given.
-fn one_sided(
+/// The names of a one-sided search's refusals (see [`super::MAX_COORDINATE`]): of a vertex
+/// of `from`, of a triangle of `to`, and what the vertex must be, for `to` the model
+/// `to_side`.
+fn reach_names(to_side: Side) -> (&'static str, &'static str, &'static str) {
+    match to_side {
+        Side::B => (
+            "model A vertex",
+            "model B triangle",
+            "coordinates must be within ±1e150 in model B's frame",
+        ),
+        Side::A => (
+            "model B vertex",
+            "model A triangle",
+            "coordinates must be within ±1e150 in model A's frame",
+        ),
+    }
+}
+
+/// The error naming the first triangle of `model` (model `side`) beyond
+/// [`super::MAX_COORDINATE`] in its own frame, where a search toward it measures.
+fn check_model_reach(model: &ObbtFile, side: Side) -> Result<(), QueryError> {
+    struct Check<'q> {
+        model: &'q ObbtFile,
+        side: Side,
+    }
+    impl TreeVisitor for Check<'_> {
+        type Output = Result<(), QueryError>;
+        fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
+            let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
+            index.check_reach(&tree, self.side, reach_names(self.side).1)
+        }
+    }
+    model.visit(Check { model, side })?
+}
+
+/// `from`'s surface in `to`'s model frame (`to` is model `to_side`), checked against
+/// [`super::MAX_COORDINATE`], with `seed` (a point of `from` in its model frame, and its
+/// triangle's input id) to start its search from.
+fn flatten(
     (from, pose_from): (&ObbtFile, &Pose),
-    (to, pose_to): (&ObbtFile, &Pose),
+    pose_to: &Pose,
     to_side: Side,
-    options: &HausdorffOptions,
     seed: Option<([f64; 3], u32)>,
-) -> Result<OneSided, QueryError> {
+) -> Result<FromModel, QueryError> {
     /// `from`'s vertices, faces (with their input ids) and nodes, in `to`'s model frame.
     struct Flatten {
         from_to_to: Pose,
@@ -316,32 +353,33 @@ fn one_sided(
         from_to_to: Pose::relative(pose_to, pose_from),
         seed,
     })??;
-    // Distances are compared squared in `to`'s frame (see `MAX_COORDINATE`).
-    let (from_vertex, to_triangle, in_to_frame) = match to_side {
-        Side::B => (
-            "model A vertex",
-            "model B triangle",
-            "coordinates must be within ±1e150 in model B's frame",
-        ),
-        Side::A => (
-            "model B vertex",
-            "model A triangle",
-            "coordinates must be within ±1e150 in model A's frame",
-        ),
-    };
-    check_reach(from_vertex, in_to_frame, from.vertices.iter().copied())?;
+    // Distances are compared squared in `to`'s frame. Only vertices of faces are measured
+    // (a mesh file may list others).
+    let (from_vertex, _, in_to_frame) = reach_names(to_side);
+    let used = from.faces.iter().flatten();
+    let posed = used.filter_map(|&v| Some((v, *from.vertices.get(v)?)));
+    check_reach(from_vertex, in_to_frame, posed)?;
+    Ok(from)
+}
+
+/// h(from, to) for `from` flattened into `to`'s frame ([`flatten`]; `pose_from` its pose),
+/// `to` checked against [`super::MAX_COORDINATE`] ([`check_model_reach`]).
+fn one_sided(
+    from: &FromModel,
+    pose_from: &Pose,
+    (to, pose_to): (&ObbtFile, &Pose),
+    options: &HausdorffOptions,
+) -> Result<OneSided, QueryError> {
     /// The bounds, run on `to`'s typed tree.
     struct Bounds<'q> {
         to: &'q ObbtFile,
         from: &'q FromModel,
         options: &'q HausdorffOptions,
-        to_triangle: &'static str,
     }
     impl TreeVisitor for Bounds<'_> {
         type Output = Result<Local, QueryError>;
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             let index = self.to.derived(|| SurfaceIndex::build(&tree))?;
-            index.check_reach(&tree, self.to_triangle)?;
             let to = To {
                 tree: &tree,
                 index: &index,
@@ -349,12 +387,7 @@ fn one_sided(
             bound(&to, self.from, self.options)
         }
     }
-    let local = to.visit(Bounds {
-        to,
-        from: &from,
-        options,
-        to_triangle,
-    })??;
+    let local = to.visit(Bounds { to, from, options })??;
     let from_point = pose_to.apply(&local.from_point);
     Ok(OneSided {
         distance: local.distance,

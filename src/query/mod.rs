@@ -173,20 +173,22 @@ pub(crate) fn check_points(points: &[[f64; 3]], to_model: &Pose) -> Result<(), Q
             return Err(bad(index, "coordinates must be finite", *x));
         }
     }
-    let posed = points.iter().map(|p| to_model.apply(&(*p).into()));
+    let posed = points
+        .iter()
+        .map(|p| to_model.apply(&(*p).into()))
+        .enumerate();
     check_reach("query point", WITHIN_REACH, posed)
 }
 
-/// The error naming the first of `points` (model frame) with a coordinate beyond
-/// [`MAX_COORDINATE`] as `what` and its position.
+/// The error naming the first of `points` (each with its index; model frame) with a
+/// coordinate beyond [`MAX_COORDINATE`] as `what` and its index.
 pub(crate) fn check_reach(
     what: &'static str,
     requirement: &'static str,
-    points: impl IntoIterator<Item = nalgebra::Vector3<f64>>,
+    points: impl IntoIterator<Item = (usize, nalgebra::Vector3<f64>)>,
 ) -> Result<(), QueryError> {
     match points
         .into_iter()
-        .enumerate()
         .find(|(_, p)| !(p.amax() <= MAX_COORDINATE))
     {
         Some((index, p)) => Err(QueryError::BadInput {

@@ -112,7 +112,9 @@ impl WindingResult {
 ///
 /// # Errors
 ///
-/// - [`QueryError::BadInput`] for a query point with a non-finite coordinate,
+/// - [`QueryError::BadInput`] for a query point with a non-finite coordinate, or one
+///   beyond [`MAX_COORDINATE`](super::MAX_COORDINATE) in the model's frame ("query
+///   point"), or a model triangle beyond it ("model triangle");
 ///   [`QueryError::BadOption`] for a tolerance not above 0 or a `beta` not above 1.
 /// - [`QueryError::CorruptTree`] or [`QueryError::Format`] for a damaged, unverified file.
 ///
@@ -174,7 +176,7 @@ fn winding_numbers_with(
         fn visit<B: BoundingVolume>(self, tree: TreeView<'_, B>) -> Self::Output {
             // Both made at the file's first such query and kept with it.
             let index = self.model.derived(|| SurfaceIndex::build(&tree))?;
-            index.check_reach(&tree, "model triangle")?;
+            index.check_reach(&tree, Side::A, "model triangle")?;
             let clusters = self.model.derived(|| Clusters::of(&index))?;
             let to_model = Pose::relative(self.pose, &Pose::identity());
             // The descent is made for each rule, so that no step asks which rule it follows.

@@ -795,6 +795,30 @@ fn models_beyond_reach_are_refused_by_name() {
         ..BuildOptions::default()
     };
     let huge = build(&common::uv_sphere(1.0, 4, 6), &huge, None).expect("builds");
+    // (Refused before any search, in either order of the symmetric query.)
+    let error = hausdorff(&huge, &id, &sphere, &id, &options).expect_err("refused");
+    assert!(
+        matches!(
+            error,
+            QueryError::BadInput {
+                what: "model A triangle" | "model A vertex",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    // A vertex no face uses is never measured, so it is not refused either.
+    let mesh = common::uv_sphere(1.0, 4, 6);
+    let mut vertices = mesh.vertices().to_vec();
+    vertices.push([1e200, 0.0, 0.0]);
+    let stray = TriMesh::new(vertices, mesh.faces().to_vec()).expect("a mesh");
+    let f64_options = BuildOptions {
+        precision: obbtree::real::Precision::F64,
+        ..BuildOptions::default()
+    };
+    let stray = build(&stray, &f64_options, None).expect("builds");
+    let h = hausdorff(&stray, &id, &sphere, &id, &options).expect("answers");
+    assert!(h.distance < 1e-6, "{h:?}");
     let error = hausdorff(&sphere, &id, &huge, &id, &options).expect_err("refused");
     assert!(
         matches!(

@@ -928,9 +928,11 @@ enum ObbtreeStatus obbtree_pair_contact_geometry(struct ObbtreePair *pair,
  * point of A's surface to B's, with that point (the witness) and its closest point on B;
  * with `symmetric`, the larger of that and the reverse. The answer `h` and the true `h*`
  * satisfy `h <= h* <= max(h (1 + rel_err), h + abs_err)`; with both 0, exact to f64
- * rounding except where the farthest point lies where two triangles of B are equally
- * near (`upper_bound` says how close). The trees may be of any volume types and
- * precisions. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error.
+ * rounding wherever the bounds close, which they do not quite where B curves or where the
+ * surfaces nearly coincide (`upper_bound` says how close). The trees may be of any volume
+ * types and precisions. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error,
+ * or models posed farther than 1e150 from each other's frame origin
+ * (`obbtree::query::MAX_COORDINATE`).
  *
  * # Safety
  *
@@ -1007,7 +1009,8 @@ enum ObbtreeStatus obbtree_ray_all_hits(const struct ObbtreeTree *tree,
  * world frame), in parallel. Points at least `max_distance` (> 0, world units; `INFINITY`
  * for none) from the model get `found = 0`, sooner. `results` holds `results_len`
  * answers, which must equal `count`; `threads` as for `obbtree_collide_batch`.
- * `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point.
+ * `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, or the first beyond
+ * ±1e150 in the model's frame (`obbtree::query::MAX_COORDINATE`).
  *
  * # Safety
  *
@@ -1032,7 +1035,8 @@ enum ObbtreeStatus obbtree_closest_points(const struct ObbtreeTree *tree,
  * `_EXACT`) and `parameter` say how far clusters are summed. `values` gets the winding numbers and `error_bounds` (if not NULL) a proven
  * bound on each one's distance from the exact sum (rounding aside); each holds `len`
  * values, which must equal `count`. `threads` as for `obbtree_collide_batch`.
- * `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, and refuses a `beta`
+ * `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, or the first beyond
+ * ±1e150 in the model's frame (`obbtree::query::MAX_COORDINATE`), and refuses a `beta`
  * not above 1 or a tolerance not above 0.
  *
  * # Safety

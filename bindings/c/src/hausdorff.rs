@@ -31,9 +31,11 @@ pub struct ObbtreeHausdorffResult {
 /// point of A's surface to B's, with that point (the witness) and its closest point on B;
 /// with `symmetric`, the larger of that and the reverse. The answer `h` and the true `h*`
 /// satisfy `h <= h* <= max(h (1 + rel_err), h + abs_err)`; with both 0, exact to f64
-/// rounding except where the farthest point lies where two triangles of B are equally
-/// near (`upper_bound` says how close). The trees may be of any volume types and
-/// precisions. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error.
+/// rounding wherever the bounds close, which they do not quite where B curves or where the
+/// surfaces nearly coincide (`upper_bound` says how close). The trees may be of any volume
+/// types and precisions. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error,
+/// or models posed farther than 1e150 from each other's frame origin
+/// (`obbtree::query::MAX_COORDINATE`).
 ///
 /// # Safety
 ///

@@ -386,7 +386,8 @@ pub unsafe extern "C" fn obbtree_ray_all_hits(
 /// world frame), in parallel. Points at least `max_distance` (> 0, world units; `INFINITY`
 /// for none) from the model get `found = 0`, sooner. `results` holds `results_len`
 /// answers, which must equal `count`; `threads` as for `obbtree_collide_batch`.
-/// `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point.
+/// `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, or the first beyond
+/// ±1e150 in the model's frame (`obbtree::query::MAX_COORDINATE`).
 ///
 /// # Safety
 ///
@@ -477,7 +478,8 @@ fn winding_options(rule: i32, parameter: f64) -> Result<WindingOptions, Error> {
 /// `_EXACT`) and `parameter` say how far clusters are summed. `values` gets the winding numbers and `error_bounds` (if not NULL) a proven
 /// bound on each one's distance from the exact sum (rounding aside); each holds `len`
 /// values, which must equal `count`. `threads` as for `obbtree_collide_batch`.
-/// `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, and refuses a `beta`
+/// `OBBTREE_STATUS_BAD_ARGUMENT` names the first non-finite point, or the first beyond
+/// ±1e150 in the model's frame (`obbtree::query::MAX_COORDINATE`), and refuses a `beta`
 /// not above 1 or a tolerance not above 0.
 ///
 /// # Safety

@@ -252,8 +252,10 @@ def closest(
     get no answer, sooner. ``threads``: None for every core, or how many. Returns a
     ``ClosestResult``.
 
-    Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points or
-    a ``max_distance`` not above 0, ``PoseError`` for a pose that is not a rigid motion.
+    Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points,
+    points or model triangles beyond ±1e150 in the model's frame (where squared distances
+    would overflow) or a ``max_distance`` not above 0, ``PoseError`` for a pose that is not
+    a rigid motion.
     """
     distance, point, tri, feature, index = _closest(
         tree, pose, _point_rows(points), float(max_distance), orthonormalize, threads
@@ -382,8 +384,9 @@ def winding_number(
     (slower: the proof adds worst cases), and ``tolerance=0`` sums every triangle exactly.
 
     Raises ``OptionError`` (a ValueError) for points of another shape, non-finite points
-    (naming the first), ``beta`` not above 1 or a negative ``tolerance``; ``PoseError`` for a
-    pose that is not a rigid motion.
+    (naming the first), points or model triangles beyond ±1e150 in the model's frame,
+    ``beta`` not above 1 or a negative ``tolerance``; ``PoseError`` for a pose that is not a
+    rigid motion.
     """
     value = _inside(tree, pose, _point_rows(points), float(beta), _tolerance(tolerance),
                     orthonormalize, threads, False)

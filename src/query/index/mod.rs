@@ -179,16 +179,17 @@ impl SurfaceIndex {
 
     /// The error naming the first triangle (by its input id) with a coordinate beyond
     /// [`MAX_COORDINATE`], for the queries that measure squared distances to the model.
-    /// `what` names such a triangle ("model triangle").
+    /// `what` names such a triangle ("model triangle"); the tree is model `which`'s.
     pub(in crate::query) fn check_reach<B: BoundingVolume>(
         &self,
         tree: &TreeView<'_, B>,
+        which: Side,
         what: &'static str,
     ) -> Result<(), QueryError> {
         match self.beyond_reach {
             Some((face, value)) => Err(QueryError::BadInput {
                 what,
-                index: source_id(tree, face, Side::A)? as usize,
+                index: source_id(tree, face, which)? as usize,
                 requirement: WITHIN_REACH,
                 value,
             }),
