@@ -180,6 +180,11 @@ pub(crate) fn check_points(points: &[[f64; 3]], to_model: &Pose) -> Result<(), Q
     check_reach("query point", WITHIN_REACH, posed)
 }
 
+/// Whether a coordinate's magnitude `x` is at most [`MAX_COORDINATE`] (NaN is not).
+pub(crate) fn within_reach(x: f64) -> bool {
+    x.abs() <= MAX_COORDINATE
+}
+
 /// The error naming the first of `points` (each with its index; model frame) with a
 /// coordinate beyond [`MAX_COORDINATE`] as `what` and its index.
 pub(crate) fn check_reach(
@@ -187,10 +192,7 @@ pub(crate) fn check_reach(
     requirement: &'static str,
     points: impl IntoIterator<Item = (usize, nalgebra::Vector3<f64>)>,
 ) -> Result<(), QueryError> {
-    match points
-        .into_iter()
-        .find(|(_, p)| !(p.amax() <= MAX_COORDINATE))
-    {
+    match points.into_iter().find(|(_, p)| !within_reach(p.amax())) {
         Some((index, p)) => Err(QueryError::BadInput {
             what,
             index,

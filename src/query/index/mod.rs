@@ -22,7 +22,7 @@ pub(in crate::query) mod ray;
 
 use super::engine::triangle;
 use super::triangle::Triangle;
-use super::{source_id, QueryError, Side, MAX_COORDINATE, WITHIN_REACH};
+use super::{source_id, within_reach, QueryError, Side, WITHIN_REACH};
 use crate::arr3;
 use crate::bv::BoundingVolume;
 use crate::real::Real;
@@ -154,7 +154,7 @@ pub(in crate::query) struct SurfaceIndex {
     triangles: Vec<Triangle>,
     /// Each one's stored face index, for its input id.
     faces: Vec<u32>,
-    /// The first stored face with a coordinate beyond [`MAX_COORDINATE`], and that
+    /// The first stored face with a coordinate beyond [`super::MAX_COORDINATE`], and that
     /// coordinate's magnitude.
     beyond_reach: Option<(u32, f64)>,
 }
@@ -178,7 +178,8 @@ impl SurfaceIndex {
     }
 
     /// The error naming the first triangle (by its input id) with a coordinate beyond
-    /// [`MAX_COORDINATE`], for the queries that measure squared distances to the model.
+    /// [`super::MAX_COORDINATE`], for the queries that measure squared distances to the
+    /// model.
     /// `what` names such a triangle ("model triangle"); the tree is model `which`'s.
     pub(in crate::query) fn check_reach<B: BoundingVolume>(
         &self,
@@ -237,7 +238,7 @@ impl SurfaceIndex {
             .collect();
         let beyond_reach = (0..count).zip(&stored).find_map(|(face, t)| {
             let largest = t.iter().map(|p| p.amax()).fold(0.0, f64::max);
-            (!(largest <= MAX_COORDINATE)).then_some((face, largest))
+            (!within_reach(largest)).then_some((face, largest))
         });
         Ok(SurfaceIndex {
             nodes,
