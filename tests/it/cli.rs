@@ -769,7 +769,7 @@ fn pose_formats_and_orthonormalize() {
     let four = "0.8660,-0.5,0,0.5,0.8660,0,0,0,1,2,0,0";
     assert_bad_input(
         &obbtree(&["distance", t, t, "--pose-b", four]),
-        "--orthonormalize",
+        "the orthonormalize option takes the nearest rotation",
     );
     let o = obbtree(&[
         "distance",
