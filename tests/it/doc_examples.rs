@@ -50,23 +50,29 @@ fn untimed(line: &str) -> &str {
     }
 }
 
+/// Runs the binary with `args` (those of `command`, as the document shows it) from the
+/// crate root, where the documents' relative paths start; it must succeed.
+fn run(command: &str, args: &[impl AsRef<std::ffi::OsStr>]) -> std::process::Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_obbtree"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{command}: {}", stderr(&o));
+    o
+}
+
 /// Runs `command` (a shell line starting `obbtree `, words split on spaces) from the crate
 /// root with `/tmp/` replaced by `tmp`, and returns its first line: of standard error when
 /// `on_stderr`, else of standard output.
 fn first_line(command: &str, tmp: &Path, on_stderr: bool) -> String {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tmp = format!("{}/", tmp.display());
     let words: Vec<String> = command
         .split_whitespace()
         .skip(1)
         .map(|w| w.replace("/tmp/", &tmp))
         .collect();
-    let o = Command::new(env!("CARGO_BIN_EXE_obbtree"))
-        .args(&words)
-        .current_dir(root)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{command}: {}", stderr(&o));
+    let o = run(command, &words);
     let text = if on_stderr { o.stderr } else { o.stdout };
     String::from_utf8_lossy(&text)
         .lines()
@@ -169,12 +175,7 @@ fn the_guide_s_transcripts_are_what_the_commands_print() {
         {
             continue;
         }
-        let o = Command::new(env!("CARGO_BIN_EXE_obbtree"))
-            .args(&args)
-            .current_dir(root)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{command}: {}", stderr(&o));
+        let o = run(command, &args);
         let printed = String::from_utf8_lossy(&o.stdout);
         let shown: Vec<String> = lines.map(timeless).collect();
         let actual: Vec<String> = printed.lines().map(timeless).collect();
