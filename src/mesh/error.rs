@@ -82,6 +82,21 @@ pub enum MeshError {
         /// What was tried.
         reason: String,
     },
+    /// The extension names one format, its parse failed, and the content is
+    /// recognisably something else (a binary STL named `.obj`, OBJ text named
+    /// `.stl`, binary data named `.obj`): the error says what to rename, not the
+    /// failed parse's symptom.
+    Misnamed {
+        /// The path as given.
+        file: String,
+        /// The format the extension names: `"OBJ"` or `"STL"`.
+        extension: &'static str,
+        /// What the content is, as a phrase: `"a binary STL"`, `"an ASCII STL"`,
+        /// `"OBJ text"` or `"binary data, not text"`.
+        content: &'static str,
+        /// The remedy: the extension to use, or `None` when the content is no mesh format.
+        rename_to: Option<&'static str>,
+    },
     /// A malformed statement or token in a text format (OBJ, ASCII STL).
     Syntax {
         /// The input and line.
@@ -150,6 +165,21 @@ impl fmt::Display for MeshError {
             MeshError::Io { file, source } => write!(f, "{file}: cannot read: {source}"),
             MeshError::UnknownFormat { file, reason } => {
                 write!(f, "{file}: unknown mesh format: {reason}")
+            }
+            MeshError::Misnamed {
+                file,
+                extension,
+                content,
+                rename_to,
+            } => {
+                write!(
+                    f,
+                    "{file}: not an {extension} file: the content is {content}"
+                )?;
+                match rename_to {
+                    Some(ext) => write!(f, "; name it {ext}"),
+                    None => Ok(()),
+                }
             }
             MeshError::Syntax { place, message } => write!(f, "{place}: {message}"),
             MeshError::IndexOutOfRange {

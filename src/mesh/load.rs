@@ -18,11 +18,17 @@ impl TriMesh {
     /// OBJ by a `v` statement; anything else is [`MeshError::UnknownFormat`].
     /// Errors name the path as given.
     ///
+    /// When the extension's format fails to parse and the content is recognisably
+    /// another (a binary STL named `.obj`), the error is [`MeshError::Misnamed`],
+    /// saying so, instead of the parse's symptom ("no vertices").
+    ///
     /// # Errors
     ///
     /// - [`MeshError::Io`] if the file cannot be read.
     /// - [`MeshError::UnknownFormat`] if neither the extension nor the content
     ///   says OBJ or STL.
+    /// - [`MeshError::Misnamed`] if the extension's format does not parse and the
+    ///   content is another format or binary data.
     /// - Any error of [`TriMesh::from_obj_bytes`] or [`TriMesh::from_stl_bytes`]
     ///   for the content.
     ///
@@ -61,9 +67,15 @@ impl TriMesh {
                 })
             }
         };
-        match format {
+        let parsed = match format {
             Format::Obj => obj::parse(&bytes, &file),
             Format::Stl => stl::parse(&bytes, &file),
+        };
+        // The extension chose the parser; if it failed, say what the content is
+        // instead, when that is something else.
+        match (parsed, by_extension) {
+            (Err(error), Some(named)) => Err(misnamed(&bytes, named, &file).unwrap_or(error)),
+            (parsed, _) => parsed,
         }
     }
 
@@ -122,6 +134,27 @@ impl TriMesh {
     pub fn from_stl_bytes(bytes: &[u8], name: &str) -> Result<TriMesh, MeshError> {
         stl::parse(bytes, name)
     }
+}
+
+/// The error for a file whose extension names `named` but whose content is
+/// recognisably another format or binary data; `None` when the content could be
+/// `named` (the parse's own error then says what is wrong).
+fn misnamed(bytes: &[u8], named: Format, file: &str) -> Option<MeshError> {
+    let (extension, content, rename_to) = match (named, sniff(bytes)) {
+        (Format::Obj, Some(Format::Stl)) if stl::has_binary_size(bytes) => {
+            ("OBJ", "a binary STL", Some(".stl"))
+        }
+        (Format::Obj, Some(Format::Stl)) => ("OBJ", "an ASCII STL", Some(".stl")),
+        (Format::Obj, None) if bytes.contains(&0) => ("OBJ", "binary data, not text", None),
+        (Format::Stl, Some(Format::Obj)) => ("STL", "OBJ text", Some(".obj")),
+        _ => return None,
+    };
+    Some(MeshError::Misnamed {
+        file: file.to_owned(),
+        extension,
+        content,
+        rename_to,
+    })
 }
 
 /// The format `bytes` look like, for files whose extension says nothing.

@@ -790,9 +790,57 @@ fn load_picks_the_format_by_extension_in_any_case() {
             .len(),
         2
     );
-    // The extension wins over content: STL bytes named .obj are parsed as OBJ.
-    std::fs::write(dir.join("wrong.obj"), &stl).expect("write");
-    assert!(TriMesh::load(&dir.join("wrong.obj")).is_err());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_misnamed_file_is_refused_with_what_its_content_is() {
+    // The extension chooses the parser; when it fails on content that is
+    // recognisably something else, the error says what to rename it to.
+    let dir = scratch_dir("misnamed");
+    let ascii_stl = std::fs::read(fixture("two_facets.stl")).expect("fixture");
+    let obj = std::fs::read(fixture("polygons.obj")).expect("fixture");
+    let mut png = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR".to_vec();
+    png.extend([0u8; 40]);
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        (
+            "binary.obj",
+            binary_stl(b"exported", &TWO_TRIANGLES),
+            "binary.obj: not an OBJ file: the content is a binary STL; name it .stl",
+        ),
+        (
+            "ascii.obj",
+            ascii_stl,
+            "ascii.obj: not an OBJ file: the content is an ASCII STL; name it .stl",
+        ),
+        (
+            "text.stl",
+            obj.clone(),
+            "text.stl: not an STL file: the content is OBJ text; name it .obj",
+        ),
+        (
+            "image.obj",
+            png,
+            "image.obj: not an OBJ file: the content is binary data, not text",
+        ),
+    ];
+    for (name, bytes, message) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).expect("write");
+        let error = TriMesh::load(&path).unwrap_err();
+        assert!(
+            matches!(error, MeshError::Misnamed { .. }),
+            "{name}: {error:?}"
+        );
+        let shown = error.to_string();
+        assert!(shown.ends_with(message), "{name}: {shown}");
+    }
+    // Content that could be the named format keeps the parse's own error.
+    std::fs::write(dir.join("empty.obj"), b"# nothing\n").expect("write");
+    assert!(matches!(
+        TriMesh::load(&dir.join("empty.obj")),
+        Err(MeshError::EmptyMesh { .. })
+    ));
     std::fs::remove_dir_all(&dir).ok();
 }
 
