@@ -21,7 +21,7 @@ pub struct DistanceOptions {
     pub rel_err: f64,
     /// Absolute error allowed (world units), >= 0.
     pub abs_err: f64,
-    /// The distance beyond which the answer is not wanted (world units, >= 0; infinite by
+    /// The distance beyond which the answer is not wanted (world units, > 0; infinite by
     /// default). Volume pairs at least this far apart are never opened, so a distance
     /// wanted only up to a range costs what its range needs; models at least this far
     /// apart give [`DistanceResult::closest`] `None`, which is exact.
@@ -371,8 +371,8 @@ fn policy(rel_err: f64, abs_err: f64, max_distance: f64) -> Result<Distance, Que
 ///
 /// # Errors
 ///
-/// [`QueryError::BadOption`] for a negative or non-finite error allowance or a negative or
-/// NaN `max_distance`; [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
+/// [`QueryError::BadOption`] for a negative or non-finite error allowance or a
+/// `max_distance` that is not greater than 0 (nothing is below 0); [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
 pub fn distance<B: BoundingVolume>(
     a: &TreeView<'_, B>,
     pose_a: &Pose,
@@ -382,10 +382,11 @@ pub fn distance<B: BoundingVolume>(
     context: &mut QueryContext,
 ) -> Result<DistanceResult, QueryError> {
     let max_distance = options.max_distance;
-    if max_distance.is_nan() || max_distance < 0.0 {
+    // Nothing is closer than 0, so a maximum of 0 could only answer "beyond" (NaN fails too).
+    if max_distance.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Err(QueryError::BadOption {
             name: "max_distance",
-            requirement: "a number >= 0",
+            requirement: "greater than 0",
             value: max_distance,
         });
     }

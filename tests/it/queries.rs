@@ -558,28 +558,30 @@ fn a_pair_at_exactly_the_maximum_distance_is_not_an_answer() {
     assert_eq!(got.closest, None);
 }
 
-/// The allowances and the maximum prune as documented: with `max_distance` 0 no volume
-/// pair is opened, even between models that touch (a pair at 0 is not below 0); with an
-/// absolute error as large as the models, the first triangle pair measured is within it
-/// of every other, and nothing more is measured.
+/// The allowances and the maximum prune as documented: a `max_distance` of 0 or less is
+/// refused (nothing is below 0); models exactly the maximum apart are beyond it (a pair
+/// at the maximum is not below it); with an absolute error as large as the models, the
+/// first triangle pair measured is within it of every other, and nothing more is
+/// measured.
 #[test]
 fn the_maximum_and_the_absolute_error_end_the_search_where_they_say() {
     let cow = common::cow();
     let file = build(&cow, &obbtree::build::BuildOptions::default(), None).unwrap();
     let mut pair = PairQuery::new(&file, &file).unwrap();
     let here = Pose::identity();
-    let nothing = DistanceOptions {
-        max_distance: 0.0,
-        ..DistanceOptions::default()
-    };
-    let negative = DistanceOptions {
-        max_distance: -1.0,
-        ..DistanceOptions::default()
-    };
-    assert!(pair.distance(&here, &here, &negative).is_err());
-    let touching = pair.distance(&here, &here, &nothing).unwrap();
-    assert_eq!(touching.closest, None);
-    assert_eq!(touching.work.nodes_visited, 1, "{:?}", touching.work);
+    for refused in [0.0, -1.0, f64::NAN] {
+        let options = DistanceOptions {
+            max_distance: refused,
+            ..DistanceOptions::default()
+        };
+        let error = pair.distance(&here, &here, &options).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("max_distance must be greater than 0"),
+            "{error}"
+        );
+    }
     // Models further apart than the maximum: their root pair is the only one tested.
     let apart = Pose::translation(1.5, 0.0, 0.0);
     let near = DistanceOptions {
@@ -592,6 +594,18 @@ fn the_maximum_and_the_absolute_error_end_the_search_where_they_say() {
     let exact = pair
         .distance(&here, &apart, &DistanceOptions::default())
         .unwrap();
+    // A maximum of exactly the distance: the closest pair is at it, not below it.
+    let at = |max_distance| DistanceOptions {
+        max_distance,
+        ..DistanceOptions::default()
+    };
+    let at_the_distance = pair.distance(&here, &apart, &at(exact.distance())).unwrap();
+    assert_eq!(at_the_distance.closest, None);
+    let above = at(exact.distance().next_up());
+    assert_eq!(
+        pair.distance(&here, &apart, &above).unwrap().distance(),
+        exact.distance()
+    );
     let loose = DistanceOptions {
         abs_err: 10.0,
         ..DistanceOptions::default()

@@ -750,7 +750,7 @@ enum ObbtreeStatus obbtree_pair_collide(struct ObbtreePair *pair,
  * finite `max_distance` (world units; pass `INFINITY` for none), models at least that far
  * apart give `found = 0` and distance +infinity, and pairs of volumes that far apart are
  * never opened. `OBBTREE_STATUS_BAD_ARGUMENT` for a negative or non-finite error, or a
- * negative or NaN `max_distance`.
+ * `max_distance` that is not greater than 0.
  *
  * # Safety
  *

@@ -671,7 +671,8 @@ pub fn collide(
 /// of finding how far (None: no limit).
 ///
 /// Returns a `DistanceResult` (distance, point_a, point_b, tri_a, tri_b, work). Raises
-/// `obbtree.OptionError` (a ValueError) for a negative or non-finite error allowance.
+/// `obbtree.OptionError` (a ValueError) for a negative or non-finite error allowance, or a
+/// max_distance that is not greater than 0.
 #[pyfunction]
 #[pyo3(signature = (a, poses_a, b, poses_b, *, rel_err=0.0, abs_err=0.0, max_distance=None, threads=None, orthonormalize=false, rule="diameter"))]
 #[allow(clippy::too_many_arguments)]

@@ -96,6 +96,8 @@ def test_orthonormalize_refuses_beyond_repair(cow):
         (lambda t: obbtree.distance(t, I, t, I, rel_err=-1), "rel_err must be"),
         (lambda t: obbtree.distance(t, I, t, I, abs_err=float("nan")), "abs_err must be"),
         (lambda t: obbtree.distance(t, I, t, I, max_distance=-1), "max_distance must be"),
+        # As for closest: nothing is nearer than 0, so 0 could only answer "beyond".
+        (lambda t: obbtree.distance(t, I, t, I, max_distance=0), "max_distance must be greater"),
         (lambda t: obbtree.within(t, I, t, I, -0.5), "tolerance must be"),
         (lambda t: obbtree.collide(t, I, t, I, threads=0), "threads must be None or 1 to 1024"),
         (lambda t: obbtree.collide(t, I, t, I, rule="largest"), "rule \"largest\" is not one of"),
