@@ -134,7 +134,8 @@ pub struct LoadedScene {
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
     let source = path.display().to_string();
     let fail = |m: String| SceneError::new(&source, m);
-    let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()).caused_by(e))?;
+    let file =
+        std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")).caused_by(e))?;
     let mut text = String::new();
     file.take(MAX_SCENE_BYTES + 1)
         .read_to_string(&mut text)

@@ -149,7 +149,7 @@ class Scene:
 
     @staticmethod
     def load(path: _Path, naive: bool = False) -> "Scene":
-        """Reads a scene file (TOML); raises SceneError."""
+        """Reads a scene file (TOML); raises SceneError, or FileError if it cannot be read."""
     def step(self, poses: Optional[Dict[str, Poses]] = None) -> Dict[str, Any]:
         """Moves the named objects and answers every pair: {"frame", "pairs", "events"}."""
     def run(self, frames: Optional[_Path] = None) -> List[Dict[str, Any]]:

@@ -135,7 +135,11 @@ impl From<BuildError> for Failure {
 
 impl From<SceneError> for Failure {
     fn from(e: SceneError) -> Failure {
-        Failure::new(Kind::Scene, e.to_string())
+        // A scene or frames file that cannot be read is a file error, as for a tree or
+        // a mesh; an asset the scene names is the scene's (its cause is the open error).
+        let unreadable = std::error::Error::source(&e).is_some_and(|c| c.is::<std::io::Error>());
+        let kind = if unreadable { Kind::File } else { Kind::Scene };
+        Failure::new(kind, e.to_string())
     }
 }
 

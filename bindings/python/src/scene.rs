@@ -48,7 +48,7 @@ impl Scene {
     /// Reads a scene file: objects, their assets (each opened or built once), rules, and
     /// the frames file it names. naive=True runs the reference instead of the scheduler
     /// (every pair's full exact query every frame). Raises `obbtree.SceneError` naming the
-    /// file, line and field of a problem.
+    /// file, line and field of a problem, `obbtree.FileError` when the file cannot be read.
     #[staticmethod]
     #[pyo3(signature = (path, naive=false))]
     fn load(py: Python<'_>, path: PathBuf, naive: bool) -> PyResult<Scene> {

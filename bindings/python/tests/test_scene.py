@@ -60,6 +60,15 @@ def test_step_errors():
         scene.step({"gripper": np.tile(np.eye(4), (2, 1, 1))})
 
 
+def test_an_unreadable_scene_file_is_a_file_error(tmp_path):
+    missing = tmp_path / "missing.toml"
+    with pytest.raises(obbtree.FileError, match="missing.toml: cannot read") as raised:
+        obbtree.Scene.load(missing)
+    assert isinstance(raised.value, OSError)
+    done = run_cli("scene", missing, check=False)
+    assert done.returncode == 1 and str(raised.value) in done.stderr
+
+
 def test_bad_scene_file_message_equals_cli(tmp_path):
     shutil.copytree(SCENES, tmp_path / "scenes")
     bad = tmp_path / "scenes" / "bad.toml"
