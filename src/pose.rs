@@ -110,6 +110,34 @@ pub struct ParsedPose {
     pub correction: f64,
 }
 
+/// The repairs made while reading many poses with repair asked for: how many rotations
+/// changed by more than [`ORTHONORMAL_TOLERANCE`], and where the largest change was, so
+/// that a reader can report them once at the end instead of correcting silently.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Repairs {
+    /// Poses corrected by more than [`ORTHONORMAL_TOLERANCE`].
+    pub count: usize,
+    /// The largest of those corrections (0 when `count` is 0).
+    pub largest: f64,
+    /// Where the largest was, in the reader's words (empty when `count` is 0).
+    pub at: String,
+}
+
+impl Repairs {
+    /// Counts `parsed`'s correction if it is above [`ORTHONORMAL_TOLERANCE`], naming its
+    /// place by `at` when it is the largest so far; returns the pose.
+    pub fn note(&mut self, parsed: &ParsedPose, at: impl FnOnce() -> String) -> Pose {
+        if parsed.correction > ORTHONORMAL_TOLERANCE {
+            self.count += 1;
+            if parsed.correction > self.largest {
+                self.largest = parsed.correction;
+                self.at = at();
+            }
+        }
+        parsed.pose
+    }
+}
+
 impl PoseFormat {
     /// Every format, default first.
     pub const ALL: [PoseFormat; 4] = [

@@ -4,7 +4,7 @@
 use super::input::{input_lines, parse_numbers, read_input};
 use super::{Failure, WithContext};
 use clap::{Args, ValueEnum};
-use obbtree::query::{ParsedPose, Pose, PoseFormat, ORTHONORMAL_TOLERANCE};
+use obbtree::query::{ParsedPose, Pose, PoseFormat, Repairs, ORTHONORMAL_TOLERANCE};
 use std::path::PathBuf;
 
 /// Where the two models are: one pose pair from flags, or a batch file.
@@ -65,7 +65,7 @@ impl ModelPoseArgs {
             self.orthonormalize,
             &mut repairs,
         )?;
-        repairs.report("--pose");
+        report(&repairs, "--pose");
         Ok(pose)
     }
 }
@@ -115,38 +115,18 @@ fn flag_pose(
     Ok(repairs.note(&parsed, || flag.to_string()))
 }
 
-/// The repairs made while reading poses, reported once on stderr.
-#[derive(Default)]
-struct Repairs {
-    count: usize,
-    largest: f64,
-    at: String,
-}
-
-impl Repairs {
-    fn note(&mut self, parsed: &ParsedPose, at: impl FnOnce() -> String) -> Pose {
-        if parsed.correction > ORTHONORMAL_TOLERANCE {
-            self.count += 1;
-            if parsed.correction > self.largest {
-                self.largest = parsed.correction;
-                self.at = at();
-            }
-        }
-        parsed.pose
-    }
-
-    fn report(&self, source: &str) {
-        match self.count {
-            0 => {}
-            1 => eprintln!(
-                "obbtree: note: {}: rotation corrected by {:.3e} to the nearest rotation",
-                self.at, self.largest
-            ),
-            n => eprintln!(
-                "obbtree: note: {source}: {n} rotations corrected by more than {ORTHONORMAL_TOLERANCE:e}, the most by {:.3e} ({})",
-                self.largest, self.at
-            ),
-        }
+/// Reports the repairs made while reading poses from `source`, once, on stderr.
+pub fn report(repairs: &Repairs, source: &str) {
+    match repairs.count {
+        0 => {}
+        1 => eprintln!(
+            "obbtree: note: {}: rotation corrected by {:.3e} to the nearest rotation",
+            repairs.at, repairs.largest
+        ),
+        n => eprintln!(
+            "obbtree: note: {source}: {n} rotations corrected by more than {ORTHONORMAL_TOLERANCE:e}, the most by {:.3e} ({})",
+            repairs.largest, repairs.at
+        ),
     }
 }
 
@@ -173,7 +153,7 @@ impl PoseArgs {
             repair,
             &mut repairs,
         )?;
-        repairs.report("--pose-a/--pose-b");
+        report(&repairs, "--pose-a/--pose-b");
         Ok((a, b))
     }
 
@@ -217,7 +197,7 @@ impl PoseArgs {
                 "{shown}: no poses (lines of pose A then pose B)"
             )));
         }
-        repairs.report(&shown);
+        report(&repairs, &shown);
         Ok(Some(out))
     }
 }

@@ -66,7 +66,9 @@ pub fn run(args: &SceneArgs) -> Result<Summary, Failure> {
         frames,
         pose_format,
         orthonormalize,
+        repairs,
     } = load(&args.scene)?;
+    super::poses::report(&repairs, &args.scene.display().to_string());
     scene.set_naive(args.naive);
     let input: Option<FramesInput> = match (args.frames.as_deref(), frames) {
         (Some("-"), _) => Some((Box::new(std::io::stdin().lock()), "-".into(), None)),
@@ -92,6 +94,7 @@ pub fn run(args: &SceneArgs) -> Result<Summary, Failure> {
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    super::poses::report(frames.repairs(), &source);
     finish(&scene, args)
 }
 

@@ -42,7 +42,9 @@ pub mod triangle;
 mod winding;
 mod work;
 
-pub use crate::pose::{ParsedPose, Pose, PoseError, PoseFormat, MAX_REPAIR, ORTHONORMAL_TOLERANCE};
+pub use crate::pose::{
+    ParsedPose, Pose, PoseError, PoseFormat, Repairs, MAX_REPAIR, ORTHONORMAL_TOLERANCE,
+};
 pub use batch::{batch, on_threads, BatchError, BatchOptions, PoseBatch};
 pub use closest::{closest_points, ClosestOptions, ClosestPoint, ClosestResult};
 pub use collide::{BoxTest, CollideOptions, CollideResult, Contact};

@@ -28,7 +28,7 @@ use crate::build::{build, BuildOptions};
 use crate::format::layout::SIGNATURE;
 use crate::format::ObbtFile;
 use crate::mesh::TriMesh;
-use crate::query::{Pose, PoseFormat};
+use crate::query::{Pose, PoseFormat, Repairs};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::io::Read;
@@ -94,6 +94,10 @@ pub struct LoadedScene {
     pub pose_format: PoseFormat,
     /// Whether rounded rotations are repaired to the nearest rotation.
     pub orthonormalize: bool,
+    /// The start poses repaired (with `orthonormalize`), the largest named as
+    /// `FILE:LINE: object K, field pose`: for a note, as a frames reader's
+    /// [`FrameReader::repairs`](super::FrameReader::repairs).
+    pub repairs: Repairs,
 }
 
 /// Reads a scene file: objects, their assets (each file opened or built once, shared by
@@ -175,6 +179,7 @@ fn parse(text: &str, source: &str, base: &Path) -> Result<LoadedScene, SceneErro
     };
     let assets = open_assets(&spec, base, &error)?;
     let mut builder = SceneBuilder::new();
+    let mut repairs = Repairs::default();
     for (k, object) in spec.object.iter().enumerate() {
         let o = object.get_ref();
         let field = |name: &str| format!("object {}, field {name}", k + 1);
@@ -184,7 +189,8 @@ fn parse(text: &str, source: &str, base: &Path) -> Result<LoadedScene, SceneErro
                 let parsed = pose_format
                     .parse(p.get_ref(), spec.orthonormalize)
                     .map_err(|e| error(p.span(), field("pose"), e.to_string()).caused_by(e))?;
-                parsed.pose
+                let line = at(p.span());
+                repairs.note(&parsed, || format!("{source}:{line}: {}", field("pose")))
             }
         };
         let groups: Vec<&str> = o
@@ -240,6 +246,7 @@ fn parse(text: &str, source: &str, base: &Path) -> Result<LoadedScene, SceneErro
         frames,
         pose_format,
         orthonormalize: spec.orthonormalize,
+        repairs,
     })
 }
 

@@ -4,7 +4,7 @@ use super::error::SceneError;
 use super::frame::Frame;
 use super::report::ObjectId;
 use super::simulate::Scene;
-use crate::query::PoseFormat;
+use crate::query::{PoseFormat, Repairs};
 use rustc_hash::FxHashMap;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -30,6 +30,7 @@ pub struct FrameReader<R> {
     ids: FxHashMap<String, ObjectId>,
     format: PoseFormat,
     repair: bool,
+    repairs: Repairs,
     buffer: Vec<u8>,
 }
 
@@ -56,6 +57,7 @@ impl<R: BufRead> FrameReader<R> {
                 .collect(),
             format,
             repair,
+            repairs: Repairs::default(),
             buffer: Vec::new(),
         }
     }
@@ -63,6 +65,12 @@ impl<R: BufRead> FrameReader<R> {
     /// Bytes read so far (for progress).
     pub fn bytes_read(&self) -> u64 {
         self.bytes
+    }
+
+    /// The rotations corrected so far when repair was asked for, the largest named as
+    /// `SOURCE:LINE: poses.NAME`: for a note at the end of a run.
+    pub fn repairs(&self) -> &Repairs {
+        &self.repairs
     }
 
     fn error(&self, message: impl Into<String>) -> SceneError {
@@ -94,7 +102,7 @@ impl<R: BufRead> FrameReader<R> {
         Some(self.parse())
     }
 
-    fn parse(&self) -> Result<Frame, SceneError> {
+    fn parse(&mut self) -> Result<Frame, SceneError> {
         let text = self.buffer.strip_suffix(b"\n").unwrap_or(&self.buffer);
         let text = text.strip_suffix(b"\r").unwrap_or(text);
         if text.iter().all(u8::is_ascii_whitespace) {
@@ -112,8 +120,12 @@ impl<R: BufRead> FrameReader<R> {
             let parsed = self
                 .format
                 .parse(values, self.repair)
-                .map_err(|e| self.error(e.to_string()).in_field(field).caused_by(e))?;
-            frame.set(id, parsed.pose);
+                .map_err(|e| self.error(e.to_string()).in_field(&field).caused_by(e))?;
+            let (source, line) = (&self.source, self.line);
+            let pose = self
+                .repairs
+                .note(&parsed, || format!("{source}:{line}: {field}"));
+            frame.set(id, pose);
         }
         Ok(frame)
     }

@@ -213,6 +213,45 @@ fn a_good_scene_from_a_mesh_and_a_tree_runs() {
     assert_eq!(lines[2]["summary"]["reused"], 1);
 }
 
+/// With `orthonormalize = true`, rotations written with four decimals are repaired, as by
+/// the `--orthonormalize` flag, and reported as it reports them: once for the start poses
+/// and once for the frames, naming the largest repair's line.
+#[test]
+fn repaired_rotations_are_noted_as_the_flag_notes_them() {
+    let dir = scene_dir("repairs");
+    let four = "0.8660,-0.5,0, 0.5,0.8660,0, 0,0,1";
+    let scene = format!("orthonormalize = true\n{}", GOOD).replace(
+        "pose = [1,0,0, 0,1,0, 0,0,1, 3,0,0]",
+        &format!("pose = [{four}, 3,0,0]"),
+    );
+    let frames = format!(
+        "{{\"poses\": {{\"b\": [{four}, 1.2,0,0]}}}}\n{{\"poses\": {{}}}}\n{{\"poses\": {{\"a\": [{four}, 0,0,0], \"b\": [0.8661,-0.5,0, 0.5,0.8661,0, 0,0,1, 1.2,0,0]}}}}\n"
+    );
+    let o = run(&dir, &scene, Some(&frames));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let notes: Vec<&str> = std::str::from_utf8(&o.stderr).unwrap().lines().collect();
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(
+        notes[0].starts_with("obbtree: note: ")
+            && notes[0].contains("scene.toml:10: object 2, field pose: rotation corrected by 1.9"),
+        "{notes:?}"
+    );
+    assert!(
+        notes[1].contains("frames.jsonl: 3 rotations corrected by more than 1e-6, the most by 5.595e-5")
+            && notes[1].ends_with("frames.jsonl:3: poses.b)"),
+        "{notes:?}"
+    );
+    // Without the option the same rotation is refused, naming where.
+    assert_bad_input(
+        &run(
+            &dir,
+            &scene.replace("orthonormalize = true", ""),
+            Some(&frames),
+        ),
+        "object 2, field pose",
+    );
+}
+
 /// A mesh beside a compact tree is built in the compact layout too, so the scene runs and
 /// answers as with fast trees.
 #[test]

@@ -58,6 +58,7 @@ impl Scene {
             frames,
             pose_format,
             orthonormalize,
+            ..
         } = loaded;
         scene.set_naive(naive);
         Ok(Scene {
