@@ -60,7 +60,7 @@ pub fn run(args: &ClosestArgs) -> Result<(), Failure> {
     })?
     .map_err(|e| rows.locate(e))?;
     if args.csv {
-        out!("point,distance,x,y,z,triangle,feature,feature_index,bv_tests,tri_tests")?;
+        out!("point,distance,x,y,z,tri,feature,feature_index,bv_tests,tri_tests")?;
     }
     for (i, (p, answer)) in points.iter().zip(&answers).enumerate() {
         print_answer(args, i, p, answer, points.len() > 1)?;
@@ -104,7 +104,7 @@ fn print_answer(
                 "found": c.is_some(),
                 "distance": c.map_or(null.clone(), |c| json!(c.distance)),
                 "closest": c.map_or(null.clone(), |c| json!(c.point)),
-                "triangle": c.map_or(null.clone(), |c| json!(c.triangle)),
+                "tri": c.map_or(null.clone(), |c| json!(c.triangle)),
                 "feature": c.map_or(null, |c| json!({"kind": c.feature.name(), "index": c.feature.index()})),
                 "work": {"bv_tests": work.bv_tests(), "tri_tests": work.tri_tests()},
             });

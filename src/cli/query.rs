@@ -335,7 +335,7 @@ fn witness_json(key: &str, w: &Witness, work: &Work, seconds: f64) -> Value {
         "point_b": point(&w.point_b),
         "tri_a": w.tri_a,
         "tri_b": w.tri_b,
-        "stats": work_json(work),
+        "work": work_json(work),
         "seconds": seconds,
     });
     insert(&mut out, key, json!(w.distance));
@@ -359,13 +359,13 @@ fn csv_columns(answer: &[&'static str]) -> Vec<&'static str> {
     let mut columns = vec!["/pose"];
     columns.extend_from_slice(answer);
     columns.extend_from_slice(&[
-        "/stats/bv_disjoint",
-        "/stats/bv_overlap",
-        "/stats/tri_separated",
-        "/stats/tri_contact",
-        "/stats/bv_tests",
-        "/stats/tri_tests",
-        "/stats/nodes_visited",
+        "/work/bv_disjoint",
+        "/work/bv_overlap",
+        "/work/tri_separated",
+        "/work/tri_contact",
+        "/work/bv_tests",
+        "/work/tri_tests",
+        "/work/nodes_visited",
         "/seconds",
     ]);
     columns
@@ -472,7 +472,7 @@ pub fn collide(args: &CollideArgs) -> Result<(), Failure> {
             "colliding": r.colliding,
             "contacts": r.pairs.len(),
             "bv_test_lower_bound": bound,
-            "stats": work_json(&r.work),
+            "work": work_json(&r.work),
             "seconds": seconds,
         });
         if args.pairs {
@@ -567,7 +567,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
                 "point_b": w.map(|w| point(&w.point_b)),
                 "tri_a": w.map(|w| w.tri_a),
                 "tri_b": w.map(|w| w.tri_b),
-                "stats": work_json(&r.work),
+                "work": work_json(&r.work),
                 "seconds": seconds,
             });
             let text = match w {
@@ -591,7 +591,7 @@ pub fn distance(args: &DistanceArgs) -> Result<(), Failure> {
             let beyond = options.max_distance;
             let value = json!({"distance": null, "beyond": beyond, "point_a": null,
                 "point_b": null, "tri_a": null, "tri_b": null,
-                "stats": work_json(&r.work), "seconds": seconds});
+                "work": work_json(&r.work), "seconds": seconds});
             let work = work_text(&r.work);
             return Ok((
                 value,
@@ -644,7 +644,7 @@ pub fn hausdorff(args: &HausdorffArgs) -> Result<(), Failure> {
             "point_b": h.point_b,
             "tri_a": h.tri_a,
             "tri_b": h.tri_b,
-            "stats": work_json(&h.work),
+            "work": work_json(&h.work),
             "seconds": seconds,
         });
         let text = format!(

@@ -116,7 +116,7 @@ pub fn run(args: &RayArgs) -> Result<(), Failure> {
     };
     let answers = with_threads(args.threads.threads, cast)?.map_err(|e| rows.locate(e))?;
     if args.csv {
-        out!("ray,hit,t,x,y,z,triangle,b0,b1,b2,nx,ny,nz,bv_tests,tri_tests")?;
+        out!("ray,hit,t,x,y,z,tri,b0,b1,b2,nx,ny,nz,bv_tests,tri_tests")?;
     }
     let many = rays.len() > 1;
     for (index, (ray, (hits, work))) in rays.iter().zip(&answers).enumerate() {
@@ -151,7 +151,7 @@ fn print_ray(
     }
     if args.json {
         let hit_json = |h: &RayHit| {
-            json!({"t": h.t, "point": ray.at(h.t), "triangle": h.triangle,
+            json!({"t": h.t, "point": ray.at(h.t), "tri": h.triangle,
                    "barycentric": h.barycentric, "normal": h.normal})
         };
         let work = json!({"bv_tests": bv, "tri_tests": tri});

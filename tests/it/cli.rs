@@ -253,7 +253,7 @@ fn collide_distance_span_print_the_contract_fields() {
     assert!(ids.windows(2).all(|w| w[0] < w[1]), "pairs are sorted");
     assert!(ids.iter().all(|&(a, b)| a < 5804 && b < 5804));
     for k in stats_keys {
-        assert!(c["stats"][k].is_u64(), "stats.{k}");
+        assert!(c["work"][k].is_u64(), "work.{k}");
     }
     assert!(c["seconds"].is_f64());
     // A mesh input is built in memory to match the other file, with the same answer.
@@ -313,7 +313,7 @@ fn collide_distance_span_print_the_contract_fields() {
 
     let s = json(&["span", f, f, "--pose-b", far, "--json"]);
     assert!(s["span"].as_f64().unwrap() > 3.0);
-    for k in ["point_a", "point_b", "stats", "seconds"] {
+    for k in ["point_a", "point_b", "work", "seconds"] {
         assert!(!s[k].is_null(), "span lacks {k}");
     }
 }
@@ -1160,7 +1160,7 @@ fn distance_with_a_maximum_prints_beyond_it() {
     let beyond = json(&["--max-distance", "0.5"]);
     assert_eq!(beyond["distance"], serde_json::Value::Null, "{beyond}");
     assert_eq!(beyond["beyond"], 0.5);
-    assert_eq!(beyond["stats"]["bv_tests"], 1);
+    assert_eq!(beyond["work"]["bv_tests"], 1);
     let exact = json(&[]);
     assert_eq!(
         json(&["--max-distance", "5"])["distance"],

@@ -246,7 +246,7 @@ fn the_cli_answers_as_the_library() {
         let c = answer.closest.expect("an answer");
         assert_eq!(line["point"], i);
         assert_eq!(line["distance"].as_f64(), Some(c.distance));
-        assert_eq!(line["triangle"], c.triangle);
+        assert_eq!(line["tri"], c.triangle);
         assert_eq!(line["feature"]["kind"], c.feature.name());
     }
     let cow_path = cow();

@@ -205,7 +205,7 @@ fn csv_rows_carry_what_json_lines_carry() {
                 }
                 other => assert_eq!(c[key], other.to_string(), "{command} {extra:?}"),
             }
-            assert_eq!(c["bv_tests"], j["stats"]["bv_tests"].to_string());
+            assert_eq!(c["bv_tests"], j["work"]["bv_tests"].to_string());
         }
     }
 }

@@ -545,7 +545,7 @@ fn the_cli_answers_as_the_library() {
         assert_eq!(line["hit"], answer.hit.is_some());
         if let Some(h) = answer.hit {
             assert!(same(line["t"].as_f64().expect("t"), h.t), "{line}");
-            assert_eq!(line["triangle"], h.triangle);
+            assert_eq!(line["tri"], h.triangle);
         }
     }
     assert!(closest[0].hit.is_some() && closest[2].hit.is_none());

@@ -237,8 +237,9 @@ fn repaired_rotations_are_noted_as_the_flag_notes_them() {
         "{notes:?}"
     );
     assert!(
-        notes[1].contains("frames.jsonl: 3 rotations corrected by more than 1e-6, the most by 5.595e-5")
-            && notes[1].ends_with("frames.jsonl:3: poses.b)"),
+        notes[1].contains(
+            "frames.jsonl: 3 rotations corrected by more than 1e-6, the most by 5.595e-5"
+        ) && notes[1].ends_with("frames.jsonl:3: poses.b)"),
         "{notes:?}"
     );
     // Without the option the same rotation is refused, naming where.

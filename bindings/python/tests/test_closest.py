@@ -24,7 +24,7 @@ def test_closest_matches_the_cli(tmp_path, cow):
     assert len(lines) == len(points)
     for i, line in enumerate(lines):
         assert line["distance"] == c.distance[i]
-        assert line["triangle"] == c.tri[i]
+        assert line["tri"] == c.tri[i]
         assert line["feature"]["kind"] == c.feature[i]
         assert np.array_equal(line["closest"], c.point[i])
     # What an answer must satisfy: the point is that far from the query.

@@ -129,7 +129,7 @@ def test_ray_matches_the_cli(tmp_path, cow):
     for i, line in enumerate(lines):
         assert line["hit"] == h.hit[i]
         if line["hit"]:
-            assert line["triangle"] == h.tri[i]
+            assert line["tri"] == h.tri[i]
             assert line["t"] == pytest.approx(h.t[i], rel=1e-15)
 
 
