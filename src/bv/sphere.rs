@@ -240,6 +240,29 @@ mod tests {
         assert!((s.surface_area() - 16.0 * pi).abs() < 1e-12);
     }
 
+    /// The trait's defaults as spheres take them: the re-wrapped test is the plain one (a
+    /// sphere re-wrapped in a sphere is itself), and the distance bound without a
+    /// threshold is the gap between the posed spheres.
+    #[test]
+    fn the_rewrapped_test_and_the_plain_bound_are_the_spheres_own() {
+        let unit = Sphere::<f64> {
+            center: [0.0, 0.0, 0.0],
+            radius: 1.0,
+        };
+        let other = Sphere::<f64> {
+            center: [1.0, 0.0, 0.0],
+            radius: 0.5,
+        };
+        for (shift, gap) in [(0.0, 0.0), (4.0, 3.5), (-7.0, 4.5)] {
+            let b_to_a = Pose::translation(shift, 0.0, 0.0);
+            let plain = unit.overlaps(&other, &b_to_a, 0.0);
+            assert_eq!(plain, gap == 0.0, "shift {shift}");
+            assert_eq!(unit.overlaps_rewrapped(&other, &b_to_a, 0.0), plain);
+            let bound = unit.distance_lower_bound(&other, &b_to_a);
+            assert!((bound - gap).abs() < 1e-12, "shift {shift}: {bound}");
+        }
+    }
+
     /// The world box holds the points at the radius along each axis from the posed centre,
     /// near the origin and far from it.
     #[test]
