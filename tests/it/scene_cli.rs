@@ -281,6 +281,14 @@ fn bad_scenes_are_one_line_naming_file_line_and_field() {
             "scene.toml:7: object 2, field name: \"a\" is also object 1",
         ),
         (
+            GOOD.replace("name = \"b\"", "name = \"b c\""),
+            "scene.toml:7: object 2, field name: \"b c\" is not a name of letters, digits, _ . -",
+        ),
+        (
+            GOOD.replace("groups = [\"g\"]", "groups = [\"g\", \"\"]"),
+            "scene.toml:4: object 1, field groups: \"\" is not a name of letters, digits, _ . -",
+        ),
+        (
             GOOD.replace("asset = \"cube.obj\"", "asset = \"missing.obbt\""),
             "scene.toml:8: object 2, field asset: ",
         ),
