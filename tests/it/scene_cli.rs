@@ -253,6 +253,28 @@ fn repaired_rotations_are_noted_as_the_flag_notes_them() {
     );
 }
 
+/// A distance rule with a maximum lists the pair while it is nearer than the maximum, and
+/// not once it is farther.
+#[test]
+fn a_distance_rule_lists_pairs_within_its_maximum() {
+    let dir = scene_dir("distance");
+    let scene = GOOD.replace(
+        "\"clearance\"\nclearance = 0.5",
+        "\"distance\"\nmax_distance = 0.5",
+    );
+    // b 0.2 from a, then 2 from it.
+    let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.2,0,0]}}\n\
+                  {\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 3,0,0]}}\n";
+    let o = run(&dir, &scene, Some(frames));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines = json_lines(&o.stdout);
+    let listed = |frame: &Value| frame["pairs"].as_array().unwrap().len();
+    assert_eq!(listed(&lines[0]), 1, "{}", lines[0]);
+    let d = lines[0]["pairs"][0]["distance"].as_f64().unwrap();
+    assert!((d - 0.2).abs() < 1e-6, "{}", lines[0]);
+    assert_eq!(listed(&lines[1]), 0, "{}", lines[1]);
+}
+
 /// A mesh beside a compact tree is built in the compact layout too, so the scene runs and
 /// answers as with fast trees.
 #[test]
