@@ -129,7 +129,10 @@ mod tests {
         let e = load("no/such/scene.toml".as_ref()).unwrap_err();
         let io: &std::io::Error = cause(&e);
         assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
-        assert_eq!(e.to_string(), format!("no/such/scene.toml: cannot read: {io}"));
+        assert_eq!(
+            e.to_string(),
+            format!("no/such/scene.toml: cannot read: {io}")
+        );
     }
 
     /// A scene file that is not TOML keeps the TOML error; the display keeps its message
