@@ -10,7 +10,6 @@ use crate::pose::Pose;
 use crate::tree::TreeView;
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// How a closest-point query is asked.
@@ -98,14 +97,7 @@ pub fn closest_points(
     points: &[[f64; 3]],
     options: &ClosestOptions,
 ) -> Result<Vec<ClosestResult>, QueryError> {
-    // (NaN fails too.)
-    if options.max_distance.partial_cmp(&0.0) != Some(Ordering::Greater) {
-        return Err(QueryError::BadOption {
-            name: "max_distance",
-            requirement: "greater than 0",
-            value: options.max_distance,
-        });
-    }
+    super::require_positive("max_distance", options.max_distance)?;
     check_points(points, &Pose::relative(pose, &Pose::identity()))?;
     /// The typed descent, run for every point.
     struct Visit<'q> {

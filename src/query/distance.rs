@@ -372,7 +372,8 @@ fn policy(rel_err: f64, abs_err: f64, max_distance: f64) -> Result<Distance, Que
 /// # Errors
 ///
 /// [`QueryError::BadOption`] for a negative or non-finite error allowance or a
-/// `max_distance` that is not greater than 0 (nothing is below 0); [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
+/// `max_distance` that is not greater than 0 (nothing is below 0);
+/// [`QueryError::CorruptTree`] when a tree's nodes are inconsistent.
 pub fn distance<B: BoundingVolume>(
     a: &TreeView<'_, B>,
     pose_a: &Pose,
@@ -382,14 +383,8 @@ pub fn distance<B: BoundingVolume>(
     context: &mut QueryContext,
 ) -> Result<DistanceResult, QueryError> {
     let max_distance = options.max_distance;
-    // Nothing is closer than 0, so a maximum of 0 could only answer "beyond" (NaN fails too).
-    if max_distance.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return Err(QueryError::BadOption {
-            name: "max_distance",
-            requirement: "greater than 0",
-            value: max_distance,
-        });
-    }
+    // Nothing is closer than 0, so a maximum of 0 could only answer "beyond".
+    super::require_positive("max_distance", max_distance)?;
     let policy = policy(options.rel_err, options.abs_err, max_distance)?;
     let warm = options.warm_start;
     let result = run(a, pose_a, b, pose_b, policy, options.rule, warm, context)?;

@@ -129,6 +129,19 @@ pub enum QueryError {
     Format(#[from] crate::format::FormatError),
 }
 
+/// `Ok` if option `name`'s `value` is greater than 0, else the [`QueryError::BadOption`]
+/// that says so (NaN fails too).
+pub(crate) fn require_positive(name: &'static str, value: f64) -> Result<(), QueryError> {
+    if value.partial_cmp(&0.0) == Some(std::cmp::Ordering::Greater) {
+        return Ok(());
+    }
+    Err(QueryError::BadOption {
+        name,
+        requirement: "greater than 0",
+        value,
+    })
+}
+
 /// `value` as an error message shows it: as Rust prints it, or in scientific notation
 /// where that would be a long run of digits.
 fn shown(value: f64) -> String {

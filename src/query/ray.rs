@@ -13,7 +13,6 @@ use crate::pose::Pose;
 use crate::tree::{NodeDefect, TreeView};
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use std::cmp::Ordering;
 use std::sync::Mutex;
 
 /// A ray: the points `origin + t · direction` for `t ≥ 0`, world frame.
@@ -251,14 +250,7 @@ fn run<C: Collect>(
     t_max: f64,
     make: impl Fn() -> C + Sync,
 ) -> Result<Vec<C::Output>, QueryError> {
-    // (NaN fails too.)
-    if t_max.partial_cmp(&0.0) != Some(Ordering::Greater) {
-        return Err(QueryError::BadOption {
-            name: "t_max",
-            requirement: "greater than 0",
-            value: t_max,
-        });
-    }
+    super::require_positive("t_max", t_max)?;
     for (index, ray) in rays.iter().enumerate() {
         check_ray(index, ray)?;
     }

@@ -138,12 +138,12 @@ pub struct LoadedScene {
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
     let source = path.display().to_string();
     let fail = |m: String| SceneError::new(&source, m);
-    let file =
-        std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")).caused_by(e))?;
+    let unreadable = |e: std::io::Error| fail(format!("cannot read: {e}")).caused_by(e);
+    let file = std::fs::File::open(path).map_err(unreadable)?;
     let mut text = String::new();
     file.take(MAX_SCENE_BYTES + 1)
         .read_to_string(&mut text)
-        .map_err(|e| fail(format!("cannot read: {e}")).caused_by(e))?;
+        .map_err(unreadable)?;
     if text.len() as u64 > MAX_SCENE_BYTES {
         return Err(fail(format!("larger than {MAX_SCENE_BYTES} bytes")));
     }
