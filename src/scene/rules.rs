@@ -163,3 +163,65 @@ impl RuleTable {
         reach
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A table of 130 rules (three words per row), where `rule` matches `(side, object)`.
+    fn table(matches: impl Fn(usize, bool, usize) -> bool) -> RuleTable {
+        let effects = (0..130)
+            .map(|rule| Effect::Clearance {
+                clearance: 1.0 + rule as f64,
+            })
+            .collect();
+        RuleTable::new(effects, 4, matches)
+    }
+
+    /// The last matching rule wins, in either order of the pair and whichever word of the
+    /// row holds it; an object with itself and a pair no rule matches get `none`.
+    #[test]
+    fn the_last_rule_matching_a_pair_in_either_order_wins() {
+        // Rule r matches (a: object r % 3, b: object 3) for r in 5, 69, 70 and 100; rule
+        // 129 matches a: object 1, b: object 2.
+        let t = table(|rule, side_b, object| match (rule, side_b) {
+            (5 | 69 | 70 | 100, false) => object == rule % 3,
+            (5 | 69 | 70 | 100, true) => object == 3,
+            (129, false) => object == 1,
+            (129, true) => object == 2,
+            _ => false,
+        });
+        let clearance = |c: f64| Effect::Clearance { clearance: c };
+        assert_eq!(t.effect(2, 3), clearance(6.0)); // rule 5, word 0
+        assert_eq!(t.effect(3, 0), clearance(70.0)); // rule 69 (b side first), word 1
+        assert_eq!(t.effect(1, 3), clearance(101.0)); // rule 100 beats 70, word 1
+        assert_eq!(t.effect(2, 1), clearance(130.0)); // rule 129, word 2, reversed
+        assert_eq!(t.effect(1, 2), clearance(130.0));
+        assert_eq!(t.effect(0, 1), Effect::None);
+        assert_eq!(t.effect(3, 3), Effect::None);
+        assert_eq!(t.effect(0, 2), Effect::None);
+        // Out-of-range objects match nothing rather than panic.
+        assert_eq!(t.effect(9, 3), Effect::None);
+    }
+
+    /// An object's reach is the largest of the rules that name it on either side, wherever
+    /// the rule's bit lies in the row.
+    #[test]
+    fn an_objects_reach_is_the_largest_of_its_rules() {
+        let t = table(|rule, side_b, object| match (rule, side_b, object) {
+            (3 | 65, false, 0) => true,
+            (127, true, 1) => true,
+            (64, true, 2) => true,
+            _ => false,
+        });
+        assert_eq!(t.reach_of(0), 66.0);
+        assert_eq!(t.reach_of(1), 128.0);
+        assert_eq!(t.reach_of(2), 65.0);
+        assert_eq!(t.reach_of(3), 0.0);
+        let none = RuleTable::new(vec![Effect::Span, Effect::None], 2, |_, _, _| true);
+        assert_eq!(none.reach_of(0), 0.0);
+        let contact = RuleTable::new(vec![Effect::Contact], 2, |_, _, _| true);
+        assert_eq!(contact.effect(0, 1), Effect::Contact);
+        assert_eq!(contact.reach_of(1), 0.0);
+    }
+}

@@ -275,6 +275,43 @@ fn a_distance_rule_lists_pairs_within_its_maximum() {
     assert_eq!(listed(&lines[1]), 0, "{}", lines[1]);
 }
 
+/// Every effect, written in a scene file by its name (`Effect::name`) with its
+/// parameters, is read back as that effect.
+#[test]
+fn every_effect_is_read_back_by_its_name() {
+    use obbtree::scene::Effect;
+    let dir = scene_dir("effects");
+    let effects = [
+        (Effect::None, ""),
+        (Effect::Contact, ""),
+        (Effect::Contacts, ""),
+        (Effect::Clearance { clearance: 0.5 }, "clearance = 0.5"),
+        (
+            Effect::Distance {
+                rel_err: 0.25,
+                max_distance: Some(2.0),
+            },
+            "rel_err = 0.25\nmax_distance = 2.0",
+        ),
+        (
+            Effect::Distance {
+                rel_err: 0.0,
+                max_distance: None,
+            },
+            "",
+        ),
+        (Effect::Span, ""),
+    ];
+    for (effect, parameters) in effects {
+        let rule = format!("effect = \"{}\"\n{parameters}\n", effect.name());
+        let text = GOOD.replace("effect = \"clearance\"\nclearance = 0.5\n", &rule);
+        let path = dir.join("effect.toml");
+        std::fs::write(&path, &text).unwrap();
+        let loaded = obbtree::scene::load(&path).unwrap_or_else(|e| panic!("{text}\n{e}"));
+        assert_eq!(loaded.scene.effect(0, 1), effect, "{text}");
+    }
+}
+
 /// A mesh beside a compact tree is built in the compact layout too, so the scene runs and
 /// answers as with fast trees.
 #[test]
