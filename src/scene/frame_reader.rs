@@ -137,3 +137,51 @@ impl<R: BufRead> Iterator for FrameReader<R> {
         self.next_frame()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::SceneBuilder;
+
+    /// The bytes read count every byte of every line read, line ends included, and stop at
+    /// the end of the input.
+    #[test]
+    fn the_bytes_read_are_those_of_the_lines_read() {
+        let scene = SceneBuilder::new().build().unwrap();
+        let lines = ["{\"poses\": {}}\n", "{\"poses\": {}}\r\n", "{\"poses\":{}}"];
+        let input = lines.concat();
+        let format = PoseFormat::default();
+        let mut frames = FrameReader::new(input.as_bytes(), "f", &scene, format, false);
+        assert_eq!(frames.bytes_read(), 0);
+        let mut total = 0;
+        for line in lines {
+            assert!(frames.next_frame().unwrap().is_ok());
+            total += line.len() as u64;
+            assert_eq!(frames.bytes_read(), total);
+        }
+        assert!(frames.next_frame().is_none());
+        assert_eq!(frames.bytes_read(), total);
+    }
+
+    /// A line of `MAX_FRAME_LINE` bytes is read whole (and judged as a frame: here empty);
+    /// one byte more is refused as too long, without reading further.
+    #[test]
+    fn a_line_longer_than_the_limit_is_refused_as_too_long() {
+        let scene = SceneBuilder::new().build().unwrap();
+        let message = |len: u64| {
+            let spaces = std::io::BufReader::new(std::io::repeat(b' ').take(len));
+            let mut frames = FrameReader::new(spaces, "f", &scene, PoseFormat::default(), false);
+            let e = frames.next_frame().unwrap().unwrap_err().to_string();
+            (e, frames.bytes_read())
+        };
+        let (at_limit, read) = message(MAX_FRAME_LINE);
+        assert!(at_limit.starts_with("f:1: empty line"), "{at_limit}");
+        assert_eq!(read, MAX_FRAME_LINE);
+        let (over, read) = message(MAX_FRAME_LINE + 5);
+        assert_eq!(
+            over,
+            format!("f:1: a frame line is longer than {MAX_FRAME_LINE} bytes")
+        );
+        assert_eq!(read, MAX_FRAME_LINE + 1);
+    }
+}
