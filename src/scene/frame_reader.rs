@@ -143,7 +143,7 @@ mod tests {
     use super::*;
     use crate::scene::SceneBuilder;
 
-    /// The bytes read count every byte of every line read, line ends included, and stop at
+    /// The bytes read count every byte of every frame read, line ends included, and stop at
     /// the end of the input.
     #[test]
     fn the_bytes_read_are_those_of_the_lines_read() {
@@ -154,8 +154,9 @@ mod tests {
         let mut frames = FrameReader::new(input.as_bytes(), "f", &scene, format, false);
         assert_eq!(frames.bytes_read(), 0);
         let mut total = 0;
+        // Through `Iterator::next`, which library users call.
         for line in lines {
-            assert!(frames.next_frame().unwrap().is_ok());
+            assert!(frames.next().unwrap().is_ok());
             total += line.len() as u64;
             assert_eq!(frames.bytes_read(), total);
         }
