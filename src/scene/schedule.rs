@@ -253,7 +253,7 @@ impl Schedule {
             work.add(&EffectWork {
                 queries: 1,
                 box_tests: outcome.work.bv_tests(),
-                triangle_tests: outcome.work.tri_separated + outcome.work.tri_contact,
+                triangle_tests: outcome.work.tri_tests(),
                 seconds: outcome.seconds,
             });
         }

@@ -172,6 +172,11 @@ fn each_effect_runs_its_query_with_the_rules_options() {
         narrow.distance.box_tests,
         cd.work.bv_tests() + ef.work.bv_tests()
     );
+    assert_eq!(narrow.contact.triangle_tests, contact.work.tri_tests());
+    assert_eq!(
+        narrow.distance.triangle_tests,
+        cd.work.tri_tests() + ef.work.tri_tests()
+    );
 
     // d moves a little: c–d starts from frame 0's answer.
     let moved = common::sliding_pose(11.62, 2);
