@@ -448,4 +448,139 @@ mod tests {
             .disagreement(&reference, effect)
             .is_some());
     }
+
+    /// The effects in the scene file's order, one of each kind.
+    fn effects() -> [Effect; 5] {
+        [
+            Effect::Contact,
+            Effect::Contacts,
+            Effect::Clearance { clearance: 0.5 },
+            Effect::Distance {
+                rel_err: 0.0,
+                max_distance: None,
+            },
+            Effect::Span,
+        ]
+    }
+
+    /// A frame's JSON: each pair's objects by name (`?` for an id without one), its effect
+    /// by the scene-file name, and the answer's own fields; each event by its name.
+    #[test]
+    fn each_answer_is_written_with_its_effects_name_and_fields() {
+        let names = ["base".to_owned(), "arm".to_owned()];
+        let answers = [
+            (Answer::Contact, json!({"contact": true})),
+            (
+                Answer::Contacts(vec![(1, 2), (3, 4)]),
+                json!({"contacts": 2, "pairs": [[1, 2], [3, 4]]}),
+            ),
+            (
+                Answer::Closer {
+                    tri_a: 5,
+                    tri_b: 6,
+                    distance: 0.25,
+                },
+                json!({"closer": true, "witness": {"tri_a": 5, "tri_b": 6, "distance": 0.25}}),
+            ),
+            (
+                distance(1.5),
+                json!({"distance": 1.5, "tri_a": 3, "tri_b": 4}),
+            ),
+            (Answer::Span(2.5), json!({"span": 2.5})),
+        ];
+        let kinds = [
+            (EventKind::ContactStarted, "contact_started"),
+            (EventKind::ContactEnded, "contact_ended"),
+            (EventKind::ClearanceViolated, "clearance_violated"),
+            (EventKind::ClearanceRestored, "clearance_restored"),
+            (EventKind::ContactStarted, "contact_started"),
+        ];
+        for (((answer, fields), effect), (kind, event)) in
+            answers.into_iter().zip(effects()).zip(kinds)
+        {
+            let mut pair = json!({"a": "base", "b": "?", "effect": effect.name()});
+            pair.as_object_mut()
+                .unwrap()
+                .extend(fields.as_object().unwrap().clone());
+            let report = FrameReport {
+                frame: 7,
+                pairs: vec![PairReport { a: 0, b: 2, answer }],
+                events: vec![Event { a: 1, b: 0, kind }],
+            };
+            let expected = json!({
+                "frame": 7,
+                "pairs": [pair],
+                "events": [{"a": "arm", "b": "base", "event": event}],
+            });
+            assert_eq!(report.to_json(&names), expected);
+        }
+    }
+
+    /// Each effect's work is kept under its own name, and the summary's totals add them all.
+    #[test]
+    fn the_summary_keeps_each_effects_work_and_totals_them() {
+        for effect in effects() {
+            let mut narrow = NarrowWork::default();
+            narrow.of(&effect).unwrap().queries = 1;
+            let named: Vec<&str> = (narrow.by_effect().into_iter())
+                .filter(|(_, w)| w.queries == 1)
+                .map(|(name, _)| name)
+                .collect();
+            assert_eq!(named, [effect.name()]);
+        }
+        assert!(NarrowWork::default().of(&Effect::None).is_none());
+
+        let work = |k: u64| EffectWork {
+            queries: k,
+            box_tests: 10 * k,
+            triangle_tests: 100 * k,
+            seconds: 0.5 * k as f64,
+        };
+        let summary = Summary {
+            frames: 4,
+            objects: 3,
+            pairs_with_effect: 2,
+            culled: 5,
+            reused: 6,
+            narrow: NarrowWork {
+                contact: work(1),
+                contacts: work(2),
+                clearance: work(3),
+                distance: work(4),
+                span: work(5),
+            },
+            early_exits: 7,
+            warm_starts: 8,
+            seconds: 2.0,
+        };
+        let total =
+            json!({"queries": 15, "box_tests": 150, "triangle_tests": 1500, "seconds": 7.5});
+        assert_eq!(
+            summary.to_json("naive"),
+            json!({"summary": {
+                "mode": "naive",
+                "frames": 4,
+                "objects": 3,
+                "pairs_with_effect": 2,
+                "culled": 5,
+                "reused": 6,
+                "narrow": {
+                    "contact": work(1).to_json(),
+                    "contacts": work(2).to_json(),
+                    "clearance": work(3).to_json(),
+                    "distance": work(4).to_json(),
+                    "span": work(5).to_json(),
+                    "total": total,
+                },
+                "early_exits": 7,
+                "warm_starts": 8,
+                "triangle_tests": 1500,
+                "box_tests": 150,
+                "seconds": 2.0,
+                "frames_per_second": 2.0,
+            }})
+        );
+        assert_eq!(work(3).to_json()["seconds"], 1.5);
+        assert_eq!(Summary::default().frames_per_second(), 0.0);
+    }
 }

@@ -312,30 +312,45 @@ fn every_effect_is_read_back_by_its_name() {
     }
 }
 
-/// "Closer than the clearance" is strict in the fast path and the naive reference alike:
-/// cubes exactly the clearance apart are not listed, and a hair nearer they are.
+/// "Closer than the clearance" and "nearer than the maximum" are strict in the fast path
+/// and the naive reference alike: cubes exactly that far apart are not listed, and a hair
+/// nearer they are.
 #[test]
-fn a_gap_of_exactly_the_clearance_is_no_violation() {
-    let dir = scene_dir("clearance-boundary");
+fn a_gap_of_exactly_the_clearance_or_maximum_is_not_listed() {
+    let dir = scene_dir("boundary");
     // Cubes of side 1; b's centre at x = 1.5 leaves a gap of exactly 0.5.
     let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.5,0,0]}}\n\
                   {\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.4999,0,0]}}\n";
-    let listed = |naive: bool| {
-        let scene = dir.join("scene.toml");
-        std::fs::write(&scene, GOOD).unwrap();
-        std::fs::write(dir.join("frames.jsonl"), frames).unwrap();
-        let (s, f) = (scene.to_str().unwrap(), dir.join("frames.jsonl"));
-        let mut args = vec!["scene", s, "--frames", f.to_str().unwrap(), "--json"];
-        if naive {
-            args.push("--naive");
+    let distance = GOOD.replace(
+        "\"clearance\"\nclearance = 0.5",
+        "\"distance\"\nmax_distance = 0.5",
+    );
+    for (scene, effect) in [(GOOD.to_owned(), "clearance"), (distance, "distance")] {
+        // Fast: the clearance stops at the violation in frame 1, the limited distance at
+        // the maximum in frame 0; the reference never stops early.
+        for (naive, early_exits) in [(false, 1), (true, 0)] {
+            let path = dir.join("scene.toml");
+            std::fs::write(&path, &scene).unwrap();
+            std::fs::write(dir.join("frames.jsonl"), frames).unwrap();
+            let (s, f) = (path.to_str().unwrap(), dir.join("frames.jsonl"));
+            let mut args = vec!["scene", s, "--frames", f.to_str().unwrap(), "--json"];
+            if naive {
+                args.push("--naive");
+            }
+            let o = obbtree(&args);
+            assert!(o.status.success(), "{}", stderr(&o));
+            let lines = json_lines(&o.stdout);
+            let listed = |l: &Value| l["pairs"].as_array().unwrap().len();
+            assert_eq!(
+                [listed(&lines[0]), listed(&lines[1])],
+                [0, 1],
+                "{effect} {naive}"
+            );
+            assert_eq!(lines[1]["pairs"][0]["effect"], effect);
+            let summary = &lines[2]["summary"];
+            assert_eq!(summary["early_exits"], early_exits, "{effect} {naive}");
         }
-        let o = obbtree(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let lines = json_lines(&o.stdout);
-        [&lines[0], &lines[1]].map(|l| l["pairs"].as_array().unwrap().len())
-    };
-    assert_eq!(listed(false), [0, 1]);
-    assert_eq!(listed(true), [0, 1]);
+    }
 }
 
 /// A mesh beside a compact tree is built in the compact layout too, so the scene runs and
