@@ -162,4 +162,23 @@ mod tests {
         let mut scene = scene;
         assert!(scene.step(&missing).unwrap_err().source().is_none());
     }
+
+    /// A scene file of exactly the size limit is read (and judged as TOML: NUL bytes are
+    /// not); one byte more is refused by its size, without reading further.
+    #[test]
+    fn a_scene_file_over_the_size_limit_is_refused_by_its_size() {
+        use super::super::file::MAX_SCENE_BYTES;
+        let name = format!("obbtree-scene-limit-{}.toml", std::process::id());
+        let path = std::env::temp_dir().join(name);
+        let message = |len: u64| {
+            // Sparse: no disk is written for the NUL bytes.
+            std::fs::File::create(&path).unwrap().set_len(len).unwrap();
+            load(&path).unwrap_err().to_string()
+        };
+        let (at_limit, over) = (message(MAX_SCENE_BYTES), message(MAX_SCENE_BYTES + 1));
+        std::fs::remove_file(&path).unwrap();
+        assert!(!at_limit.contains("larger than"), "{at_limit}");
+        let limit = format!("larger than {MAX_SCENE_BYTES} bytes");
+        assert_eq!(over, format!("{}: {limit}", path.display()));
+    }
 }
