@@ -181,4 +181,41 @@ mod tests {
         let limit = format!("larger than {MAX_SCENE_BYTES} bytes");
         assert_eq!(over, format!("{}: {limit}", path.display()));
     }
+
+    /// A scene of as many objects, or as many rules, as the limits allow loads; one more
+    /// of either, or many more, is refused before any asset is opened.
+    #[test]
+    fn scenes_over_the_object_or_rule_limit_are_refused() {
+        use super::super::file::{MAX_OBJECTS, MAX_RULES};
+        let dir = std::env::temp_dir().join(format!("obbtree-limits-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let load_with = |objects: usize, rules: usize| {
+            let mut text = String::new();
+            for k in 0..objects {
+                text += &format!("[[object]]\nname = \"o{k}\"\nasset = \"t.obj\"\n");
+            }
+            for _ in 0..rules {
+                text += "[[rule]]\na = \"o0\"\nb = \"o1\"\neffect = \"contact\"\n";
+            }
+            let path = dir.join("scene.toml");
+            std::fs::write(&path, text).unwrap();
+            load(&path).map(|_| ()).map_err(|e| e.to_string())
+        };
+        let refused = Err(format!(
+            "{}: at most {MAX_OBJECTS} objects and {MAX_RULES} rules",
+            dir.join("scene.toml").display()
+        ));
+        assert_eq!(load_with(MAX_OBJECTS, 1), Ok(()));
+        assert_eq!(load_with(2, MAX_RULES), Ok(()));
+        for (objects, rules) in [
+            (MAX_OBJECTS + 1, 1),
+            (2 * MAX_OBJECTS, 1),
+            (2, MAX_RULES + 1),
+            (2, 2 * MAX_RULES),
+        ] {
+            assert_eq!(load_with(objects, rules), refused, "{objects} {rules}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -417,7 +417,8 @@ mod tests {
     }
 
     /// The fast path's distance may exceed the reference's by the rule's `rel_err` and
-    /// rounding (1e-9 of the distance plus 1e-9), and fall below it by rounding only.
+    /// rounding (1e-9 of the distance plus 1e-9), and fall below it by rounding only; a
+    /// span may differ by rounding either way.
     #[test]
     fn distances_agree_within_the_rules_error_and_rounding() {
         let y = 10.0;
@@ -439,6 +440,15 @@ mod tests {
             assert!(agrees(y - 0.9 * rounding, rel_err));
             assert!(!agrees(y - 1.1 * rounding, rel_err));
         }
+        // Spans agree to rounding only.
+        let span = one_pair(1, Answer::Span(y));
+        let spans_agree = |x: f64| {
+            one_pair(1, Answer::Span(x))
+                .disagreement(&span, |_, _| Effect::Span)
+                .is_none()
+        };
+        assert!(spans_agree(y + 0.9 * rounding) && spans_agree(y - 0.9 * rounding));
+        assert!(!spans_agree(y + 1.1 * rounding) && !spans_agree(y - 1.1 * rounding));
         // Another pair, or another kind of answer, disagrees whatever the distances.
         let effect = |_: ObjectId, _: ObjectId| Effect::Span;
         assert!(one_pair(2, distance(y))

@@ -395,7 +395,7 @@ fn bad_scenes_are_one_line_naming_file_line_and_field() {
         ),
         (
             GOOD.replace("asset = \"cube.obj\"", "asset = \"cube-aabb.obbt\""),
-            "stores aabb f32 but \"a\" stores obb f32",
+            "scene.toml:8: object 2, field asset: object \"b\" stores aabb f32 but \"a\" stores obb f32",
         ),
         (
             GOOD.replace("effect = \"none\"", "effect = \"explode\""),
