@@ -418,7 +418,7 @@ mod tests {
 
     /// The fast path's distance may exceed the reference's by the rule's `rel_err` and
     /// rounding (1e-9 of the distance plus 1e-9), and fall below it by rounding only; a
-    /// span may differ by rounding either way.
+    /// span may differ by rounding either way, a clearance's witness by anything below it.
     #[test]
     fn distances_agree_within_the_rules_error_and_rounding() {
         let y = 10.0;
@@ -449,6 +449,20 @@ mod tests {
         };
         assert!(spans_agree(y + 0.9 * rounding) && spans_agree(y - 0.9 * rounding));
         assert!(!spans_agree(y + 1.1 * rounding) && !spans_agree(y - 1.1 * rounding));
+        // Any witness closer than the clearance is right, and one that is not is wrong.
+        let closer = |distance: f64| Answer::Closer {
+            tri_a: 1,
+            tri_b: 2,
+            distance,
+        };
+        let clearance = |_: ObjectId, _: ObjectId| Effect::Clearance { clearance: 0.5 };
+        let violated = one_pair(1, closer(0.1));
+        assert!(one_pair(1, closer(0.45))
+            .disagreement(&violated, clearance)
+            .is_none());
+        assert!(one_pair(1, closer(0.5))
+            .disagreement(&violated, clearance)
+            .is_some());
         // Another pair, or another kind of answer, disagrees whatever the distances.
         let effect = |_: ObjectId, _: ObjectId| Effect::Span;
         assert!(one_pair(2, distance(y))

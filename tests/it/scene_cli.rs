@@ -378,6 +378,10 @@ fn bad_scenes_are_one_line_naming_file_line_and_field() {
             "scene.toml:13: rule 1, field b: no object or group named \"robto\"",
         ),
         (
+            GOOD.replace("a = \"a\"", "a = \"robto\""),
+            "scene.toml:12: rule 1, field a: no object or group named \"robto\"",
+        ),
+        (
             GOOD.replace("name = \"b\"", "name = \"a\""),
             "scene.toml:7: object 2, field name: \"a\" is also object 1",
         ),
