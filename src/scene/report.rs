@@ -440,15 +440,18 @@ mod tests {
             assert!(agrees(y - 0.9 * rounding, rel_err));
             assert!(!agrees(y - 1.1 * rounding, rel_err));
         }
-        // Spans agree to rounding only.
-        let span = one_pair(1, Answer::Span(y));
-        let spans_agree = |x: f64| {
-            one_pair(1, Answer::Span(x))
-                .disagreement(&span, |_, _| Effect::Span)
-                .is_none()
-        };
-        assert!(spans_agree(y + 0.9 * rounding) && spans_agree(y - 0.9 * rounding));
-        assert!(!spans_agree(y + 1.1 * rounding) && !spans_agree(y - 1.1 * rounding));
+        // Spans agree to rounding only, small ones to the absolute term.
+        for y in [y, 0.1] {
+            let span = one_pair(1, Answer::Span(y));
+            let spans_agree = |x: f64| {
+                one_pair(1, Answer::Span(x))
+                    .disagreement(&span, |_, _| Effect::Span)
+                    .is_none()
+            };
+            let rounding = 1e-9 * (1.0 + y);
+            assert!(spans_agree(y + 0.9 * rounding) && spans_agree(y - 0.9 * rounding));
+            assert!(!spans_agree(y + 1.1 * rounding) && !spans_agree(y - 1.1 * rounding));
+        }
         // Any witness closer than the clearance is right, and one that is not is wrong.
         let closer = |distance: f64| Answer::Closer {
             tri_a: 1,
