@@ -208,11 +208,11 @@ mod tests {
     /// the rule's bit lies in the row.
     #[test]
     fn an_objects_reach_is_the_largest_of_its_rules() {
-        let t = table(|rule, side_b, object| match (rule, side_b, object) {
-            (3 | 65, false, 0) => true,
-            (127, true, 1) => true,
-            (64, true, 2) => true,
-            _ => false,
+        let t = table(|rule, side_b, object| {
+            matches!(
+                (rule, side_b, object),
+                (3 | 65, false, 0) | (127, true, 1) | (64, true, 2)
+            )
         });
         assert_eq!(t.reach_of(0), 66.0);
         assert_eq!(t.reach_of(1), 128.0);
