@@ -183,6 +183,11 @@ clearance = 0.5
 
 /// Writes `text` as a scene and runs it (with `frames` as its frames when given).
 fn run(dir: &Path, text: &str, frames: Option<&str>) -> std::process::Output {
+    run_with(dir, text, frames, &[])
+}
+
+/// [`run`] with more arguments for `obbtree scene`.
+fn run_with(dir: &Path, text: &str, frames: Option<&str>, more: &[&str]) -> std::process::Output {
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, text).unwrap();
     let mut args = vec![
@@ -195,6 +200,7 @@ fn run(dir: &Path, text: &str, frames: Option<&str>) -> std::process::Output {
         std::fs::write(&path, f).unwrap();
         args.extend(["--frames".into(), path.display().to_string()]);
     }
+    args.extend(more.iter().map(|&a| a.to_owned()));
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
     obbtree(&refs)
 }
@@ -329,15 +335,8 @@ fn a_gap_of_exactly_the_clearance_or_maximum_is_not_listed() {
         // Fast: the clearance stops at the violation in frame 1, the limited distance at
         // the maximum in frame 0; the reference never stops early.
         for (naive, early_exits) in [(false, 1), (true, 0)] {
-            let path = dir.join("scene.toml");
-            std::fs::write(&path, &scene).unwrap();
-            std::fs::write(dir.join("frames.jsonl"), frames).unwrap();
-            let (s, f) = (path.to_str().unwrap(), dir.join("frames.jsonl"));
-            let mut args = vec!["scene", s, "--frames", f.to_str().unwrap(), "--json"];
-            if naive {
-                args.push("--naive");
-            }
-            let o = obbtree(&args);
+            let more: &[&str] = if naive { &["--naive"] } else { &[] };
+            let o = run_with(&dir, &scene, Some(frames), more);
             assert!(o.status.success(), "{}", stderr(&o));
             let lines = json_lines(&o.stdout);
             let listed = |l: &Value| l["pairs"].as_array().unwrap().len();
