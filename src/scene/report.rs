@@ -234,9 +234,9 @@ impl FrameReport {
                         Answer::Distance { distance: x, .. },
                         Answer::Distance { distance: y, .. },
                     ) => {
-                        close(*x, *y)
-                            || (*x >= y - 1e-9 * (1.0 + y)
-                                && *x <= y * (1.0 + rel_err) + 1e-9 * (1.0 + y))
+                        // Within rounding either way, or above by at most `rel_err`: `close`
+                        // already takes the rounding below `y`.
+                        close(*x, *y) || (*x >= *y && *x <= y * (1.0 + rel_err) + 1e-9 * (1.0 + y))
                     }
                     (Answer::Span(x), Answer::Span(y)) => close(*x, *y),
                     (x, y) => x == y,
@@ -421,25 +421,28 @@ mod tests {
     /// span may differ by rounding either way, a clearance's witness by anything below it.
     #[test]
     fn distances_agree_within_the_rules_error_and_rounding() {
-        let y = 10.0;
-        let reference = one_pair(1, distance(y));
-        let agrees = |x: f64, rel_err: f64| {
-            let effect = |_: ObjectId, _: ObjectId| Effect::Distance {
-                rel_err,
-                max_distance: None,
+        // Large and small distances: the rounding's absolute term matters for the small.
+        for y in [10.0, 0.1] {
+            let reference = one_pair(1, distance(y));
+            let agrees = |x: f64, rel_err: f64| {
+                let effect = |_: ObjectId, _: ObjectId| Effect::Distance {
+                    rel_err,
+                    max_distance: None,
+                };
+                one_pair(1, distance(x))
+                    .disagreement(&reference, effect)
+                    .is_none()
             };
-            one_pair(1, distance(x))
-                .disagreement(&reference, effect)
-                .is_none()
-        };
-        let rounding = 1e-9 * (1.0 + y);
-        for rel_err in [0.0, 0.01] {
-            let top = y * (1.0 + rel_err);
-            assert!(agrees(top + 0.9 * rounding, rel_err));
-            assert!(!agrees(top + 1.1 * rounding, rel_err));
-            assert!(agrees(y - 0.9 * rounding, rel_err));
-            assert!(!agrees(y - 1.1 * rounding, rel_err));
+            let rounding = 1e-9 * (1.0 + y);
+            for rel_err in [0.0, 0.01] {
+                let top = y * (1.0 + rel_err);
+                assert!(agrees(top + 0.9 * rounding, rel_err));
+                assert!(!agrees(top + 1.1 * rounding, rel_err));
+                assert!(agrees(y - 0.9 * rounding, rel_err));
+                assert!(!agrees(y - 1.1 * rounding, rel_err));
+            }
         }
+        let (y, reference) = (10.0, one_pair(1, distance(10.0)));
         // Spans agree to rounding only, small ones to the absolute term.
         for y in [y, 0.1] {
             let span = one_pair(1, Answer::Span(y));
@@ -465,6 +468,10 @@ mod tests {
             .is_none());
         assert!(one_pair(1, closer(0.5))
             .disagreement(&violated, clearance)
+            .is_some());
+        // Either side's witness: a reference at the clearance is wrong too.
+        assert!(violated
+            .disagreement(&one_pair(1, closer(0.5)), clearance)
             .is_some());
         // Another pair, or another kind of answer, disagrees whatever the distances.
         let effect = |_: ObjectId, _: ObjectId| Effect::Span;
