@@ -170,3 +170,52 @@ impl Scene {
         Ok(&self.report)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Effect, Frame, SceneBuilder};
+    use crate::format::ObbtFile;
+    use crate::query::Pose;
+    use std::sync::Arc;
+
+    /// What the bindings and the CLI read a scene by: its objects and names in scene
+    /// order, an id by name, the mode, the last report, and the summary's frames and time
+    /// after steps.
+    #[test]
+    fn a_scene_is_read_back_by_its_accessors() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/table.obbt");
+        let table = Arc::new(ObbtFile::open(path).unwrap());
+        let far = Pose::translation(10.0, 0.0, 0.0);
+        let mut builder = SceneBuilder::new();
+        builder.object("a", table.clone(), &["g"], Pose::identity());
+        builder.object("b", table, &["g"], far);
+        builder.rule("g", "g", Effect::Contact);
+        let mut scene = builder.build().unwrap();
+        assert_eq!(scene.names(), ["a", "b"]);
+        let objects: Vec<_> = scene
+            .objects()
+            .iter()
+            .map(|o| (o.name.as_str(), o.pose))
+            .collect();
+        assert_eq!(objects, [("a", Pose::identity()), ("b", far)]);
+        assert_eq!(
+            ["a", "b", "c"].map(|n| scene.object_id(n)),
+            [Some(0), Some(1), None]
+        );
+        assert!(!scene.is_naive());
+        scene.set_naive(true);
+        assert!(scene.is_naive());
+        scene.set_naive(false);
+        assert!(!scene.is_naive());
+        scene.step(&Frame::new()).unwrap();
+        let touching = scene
+            .step(Frame::new().set(1, Pose::identity()))
+            .unwrap()
+            .clone();
+        assert_eq!(touching.pairs.len(), 1);
+        assert_eq!(scene.report(), &touching);
+        assert_eq!(scene.summary().frames, 2);
+        // Each step adds its own (positive) time.
+        assert!(scene.summary().seconds > 0.0);
+    }
+}
