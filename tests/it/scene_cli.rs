@@ -367,6 +367,23 @@ fn a_mesh_beside_a_compact_tree_is_built_to_match() {
     assert_eq!(compact[1]["events"], fast[1]["events"]);
 }
 
+/// A tree is known by its signature whatever its file is called: a copy of `cube.obbt`
+/// named `cube.tree` loads as that tree (not as a mesh of an unknown format) and answers
+/// as it does.
+#[test]
+fn a_tree_is_known_by_its_signature_whatever_its_name() {
+    let dir = scene_dir("signature");
+    std::fs::copy(dir.join("cube.obbt"), dir.join("cube.tree")).unwrap();
+    let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.2,0,0]}}\n{\"poses\": {}}\n";
+    let named = run(&dir, GOOD, Some(frames));
+    let renamed_scene = GOOD.replace("asset = \"cube.obbt\"", "asset = \"cube.tree\"");
+    let renamed = run(&dir, &renamed_scene, Some(frames));
+    assert!(renamed.status.success(), "{}", stderr(&renamed));
+    let (named, renamed) = (json_lines(&named.stdout), json_lines(&renamed.stdout));
+    // The two frames (the summary after them holds times).
+    assert_eq!((renamed.len(), &renamed[..2]), (3, &named[..2]));
+}
+
 #[test]
 fn bad_scenes_are_one_line_naming_file_line_and_field() {
     let dir = scene_dir("bad");
