@@ -164,6 +164,9 @@ fn features_name_where_the_point_lies() {
     let edge = at([1.0, 0.0, 1.0]);
     assert!(matches!(edge.feature, Feature::Edge(_)), "{edge:?}");
     assert!((edge.distance - 0.5f64.sqrt()).abs() < 1e-15);
+    // The names the CLI and the bindings print.
+    let names = [face, edge, corner].map(|c| c.feature.name());
+    assert_eq!(names, ["face", "edge", "vertex"]);
     // On the surface: distance 0, the point itself.
     let on = at([0.5, 0.25, -0.125]);
     assert_eq!(on.distance, 0.0);
@@ -315,6 +318,30 @@ fn a_sliver_gets_its_nearest_point() {
     let reference = point_triangle_distance(&p, &t);
     assert!((reference - 1.6051518805091713).abs() < 1e-9, "{reference}");
     assert!(((p - q).norm() - reference).abs() < 1e-12, "{q:?}");
+}
+
+/// Each Voronoi region of a triangle gives its feature: the face, edge `k` (from corner `k`
+/// to corner `k + 1`) or corner `k`, with that number, and the exact closest point.
+#[test]
+fn each_region_of_a_triangle_names_its_feature_and_number() {
+    use obbtree::query::triangle::closest_point_on_triangle;
+    let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].map(Vector3::from);
+    for (p, q, feature, index) in [
+        ([0.25, 0.25, 1.0], [0.25, 0.25, 0.0], Feature::Face, 0),
+        ([0.5, -1.0, 0.5], [0.5, 0.0, 0.0], Feature::Edge(0), 0),
+        ([1.0, 1.0, 0.0], [0.5, 0.5, 0.0], Feature::Edge(1), 1),
+        ([-1.0, 0.5, 0.0], [0.0, 0.5, 0.0], Feature::Edge(2), 2),
+        ([-1.0, -1.0, 0.0], [0.0, 0.0, 0.0], Feature::Vertex(0), 0),
+        ([2.0, -1.0, 0.0], [1.0, 0.0, 0.0], Feature::Vertex(1), 1),
+        ([-1.0, 3.0, 0.0], [0.0, 1.0, 0.0], Feature::Vertex(2), 2),
+    ] {
+        let (got, f) = closest_point_on_triangle(&Vector3::from(p), &t);
+        assert_eq!(
+            (got, f, f.index()),
+            (Vector3::from(q), feature, index),
+            "{p:?}"
+        );
+    }
 }
 
 /// Triangles of no area along one axis-aligned line make boxes of no area: the index's
