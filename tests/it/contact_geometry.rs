@@ -30,6 +30,16 @@ fn a_crossing_pair_meets_along_its_known_segment() {
     ends.sort_by(|p, q| p.y.total_cmp(&q.y));
     assert_eq!(ends, vec![v(0.5, 0.0, 0.0), v(0.5, 1.5, 0.0)]);
     assert_eq!(meet.length(), 1.5);
+    // Each cuts the other short: the cut is where their chords overlap (z from -5 to 0),
+    // neither chord whole, also for corners placed about the origin.
+    let long: Triangle = [v(-1.0, 0.0, -10.0), v(1.0, 0.0, -10.0), v(1.0, 0.0, 10.0)];
+    let upright: Triangle = [v(0.0, -5.0, -5.0), v(0.0, 5.0, -5.0), v(0.0, 0.0, 5.0)];
+    for (x, y) in [(&long, &upright), (&upright, &long)] {
+        let meet = triangle_intersection(x, y).expect("they cross");
+        let mut ends: Vec<Vector3<f64>> = meet.points().to_vec();
+        ends.sort_by(|p, q| p.z.total_cmp(&q.z));
+        assert_eq!(ends, vec![v(0.0, 0.0, -5.0), v(0.0, 0.0, 0.0)]);
+    }
     // Touching at one corner: a segment of length 0 at that corner.
     let c: Triangle = [v(2.0, 0.0, 0.0), v(3.0, 0.0, 1.0), v(3.0, 1.0, -1.0)];
     let corner = triangle_intersection(&a, &c).expect("they touch");
@@ -37,6 +47,29 @@ fn a_crossing_pair_meets_along_its_known_segment() {
     // Apart: nothing.
     let far: Triangle = [v(5.0, 0.0, 0.0), v(6.0, 0.0, 0.0), v(5.0, 1.0, 0.0)];
     assert!(triangle_intersection(&a, &far).is_none());
+}
+
+/// Triangles that meet at one point where an edge of each crosses the other's plane, their
+/// chords along the planes' common line meeting end to end: the cut is that point. Each
+/// edge crosses a third of its way along, so each chord's end is rounded on its own and the
+/// two ends may pass each other; the answer must still be the point, wherever it lies.
+#[test]
+fn chords_meeting_end_to_end_give_their_one_common_point() {
+    for (s, t) in [(1.0, 1.0), (3.0, 5.0), (7.0, 3.0), (5.0, 9.0)] {
+        // `a` in z = 0 meets the x axis from below 0 up to 0, `b` in y = 0 from 0 up.
+        let a: Triangle = [v(s, -1.0, 0.0), v(-2.0 * s, 2.0, 0.0), v(-3.0, -1.0, 0.0)];
+        let b: Triangle = [v(-t, 0.0, -1.0), v(2.0 * t, 0.0, 2.0), v(3.0, 0.0, -1.0)];
+        for at in [v(1.0, 2.0, 3.0), v(-7.0, 5.0, 11.0), v(100.0, -3.0, 0.5)] {
+            let (a, b) = (a.map(|p| p + at), b.map(|p| p + at));
+            for (x, y) in [(&a, &b), (&b, &a)] {
+                let meet = triangle_intersection(x, y).expect("they touch");
+                assert_eq!(meet.kind, IntersectionKind::Segment);
+                for p in meet.points() {
+                    assert!((p - at).norm() <= 1e-13 * at.norm(), "{p:?} for {at:?}");
+                }
+            }
+        }
+    }
 }
 
 #[test]
