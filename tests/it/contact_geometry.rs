@@ -31,10 +31,11 @@ fn a_crossing_pair_meets_along_its_known_segment() {
     assert_eq!(ends, vec![v(0.5, 0.0, 0.0), v(0.5, 1.5, 0.0)]);
     assert_eq!(meet.length(), 1.5);
     // Each cuts the other short: the cut is where their chords overlap (z from -5 to 0),
-    // neither chord whole, also for corners placed about the origin.
-    let long: Triangle = [v(-1.0, 0.0, -10.0), v(1.0, 0.0, -10.0), v(1.0, 0.0, 10.0)];
+    // neither chord whole, also for corners placed about the origin, in either order.
+    let [p, q, r] = [v(-1.0, 0.0, -10.0), v(1.0, 0.0, -10.0), v(1.0, 0.0, 10.0)];
     let upright: Triangle = [v(0.0, -5.0, -5.0), v(0.0, 5.0, -5.0), v(0.0, 0.0, 5.0)];
-    for (x, y) in [(&long, &upright), (&upright, &long)] {
+    let (long, turned): (Triangle, Triangle) = ([p, q, r], [p, r, q]);
+    for (x, y) in [(&long, &upright), (&upright, &long), (&turned, &upright)] {
         let meet = triangle_intersection(x, y).expect("they cross");
         let mut ends: Vec<Vector3<f64>> = meet.points().to_vec();
         ends.sort_by(|p, q| p.z.total_cmp(&q.z));
@@ -51,22 +52,26 @@ fn a_crossing_pair_meets_along_its_known_segment() {
 
 /// Triangles that meet at one point where an edge of each crosses the other's plane, their
 /// chords along the planes' common line meeting end to end: the cut is that point. Each
-/// edge crosses a third of its way along, so each chord's end is rounded on its own and the
-/// two ends may pass each other; the answer must still be the point, wherever it lies.
+/// edge crosses a third of its way along, so each chord's end is rounded on its own; with
+/// these translations (found by a search over translations of three decimals) the two ends
+/// pass each other, and the answer must still be the point, wherever it lies.
 #[test]
 fn chords_meeting_end_to_end_give_their_one_common_point() {
-    for (s, t) in [(1.0, 1.0), (3.0, 5.0), (7.0, 3.0), (5.0, 9.0)] {
+    for (s, t, at) in [
+        (3.0, 5.0, v(0.001, 15.372, -23.062)),
+        (9.0, 6.0, v(1.421, 3.236, 39.354)),
+        (8.0, 5.0, v(-7.871, 43.393, 7.044)),
+        (4.0, 9.0, v(-0.722, -14.523, 16.173)),
+    ] {
         // `a` in z = 0 meets the x axis from below 0 up to 0, `b` in y = 0 from 0 up.
         let a: Triangle = [v(s, -1.0, 0.0), v(-2.0 * s, 2.0, 0.0), v(-3.0, -1.0, 0.0)];
         let b: Triangle = [v(-t, 0.0, -1.0), v(2.0 * t, 0.0, 2.0), v(3.0, 0.0, -1.0)];
-        for at in [v(1.0, 2.0, 3.0), v(-7.0, 5.0, 11.0), v(100.0, -3.0, 0.5)] {
-            let (a, b) = (a.map(|p| p + at), b.map(|p| p + at));
-            for (x, y) in [(&a, &b), (&b, &a)] {
-                let meet = triangle_intersection(x, y).expect("they touch");
-                assert_eq!(meet.kind, IntersectionKind::Segment);
-                for p in meet.points() {
-                    assert!((p - at).norm() <= 1e-13 * at.norm(), "{p:?} for {at:?}");
-                }
+        let (a, b) = (a.map(|p| p + at), b.map(|p| p + at));
+        for (x, y) in [(&a, &b), (&b, &a)] {
+            let meet = triangle_intersection(x, y).expect("they touch");
+            assert_eq!(meet.kind, IntersectionKind::Segment);
+            for p in meet.points() {
+                assert!((p - at).norm() <= 1e-13 * at.norm(), "{p:?} for {at:?}");
             }
         }
     }
