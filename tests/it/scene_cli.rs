@@ -205,6 +205,16 @@ fn run_with(dir: &Path, text: &str, frames: Option<&str>, more: &[&str]) -> std:
     obbtree(&refs)
 }
 
+/// Runs [`GOOD`], then `GOOD` with its tree `cube.obbt` replaced by `asset`, on `frames`:
+/// the JSON lines of each (the second run must succeed).
+fn run_good_and_with_tree(dir: &Path, asset: &str, frames: &str) -> (Vec<Value>, Vec<Value>) {
+    let good = run(dir, GOOD, Some(frames));
+    let scene = GOOD.replace("asset = \"cube.obbt\"", &format!("asset = \"{asset}\""));
+    let other = run(dir, &scene, Some(frames));
+    assert!(other.status.success(), "{}", stderr(&other));
+    (json_lines(&good.stdout), json_lines(&other.stdout))
+}
+
 #[test]
 fn a_good_scene_from_a_mesh_and_a_tree_runs() {
     let dir = scene_dir("good");
@@ -358,11 +368,7 @@ fn a_gap_of_exactly_the_clearance_or_maximum_is_not_listed() {
 fn a_mesh_beside_a_compact_tree_is_built_to_match() {
     let dir = scene_dir("compact");
     let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.2,0,0]}}\n";
-    let fast = run(&dir, GOOD, Some(frames));
-    let compact_scene = GOOD.replace("asset = \"cube.obbt\"", "asset = \"cube-compact.obbt\"");
-    let compact = run(&dir, &compact_scene, Some(frames));
-    assert!(compact.status.success(), "{}", stderr(&compact));
-    let (fast, compact) = (json_lines(&fast.stdout), json_lines(&compact.stdout));
+    let (fast, compact) = run_good_and_with_tree(&dir, "cube-compact.obbt", frames);
     assert_eq!(compact[0]["events"], fast[0]["events"]);
     assert_eq!(compact[1]["events"], fast[1]["events"]);
 }
@@ -375,11 +381,7 @@ fn a_tree_is_known_by_its_signature_whatever_its_name() {
     let dir = scene_dir("signature");
     std::fs::copy(dir.join("cube.obbt"), dir.join("cube.tree")).unwrap();
     let frames = "{\"poses\": {\"b\": [1,0,0, 0,1,0, 0,0,1, 1.2,0,0]}}\n{\"poses\": {}}\n";
-    let named = run(&dir, GOOD, Some(frames));
-    let renamed_scene = GOOD.replace("asset = \"cube.obbt\"", "asset = \"cube.tree\"");
-    let renamed = run(&dir, &renamed_scene, Some(frames));
-    assert!(renamed.status.success(), "{}", stderr(&renamed));
-    let (named, renamed) = (json_lines(&named.stdout), json_lines(&renamed.stdout));
+    let (named, renamed) = run_good_and_with_tree(&dir, "cube.tree", frames);
     // The two frames (the summary after them holds times).
     assert_eq!((renamed.len(), &renamed[..2]), (3, &named[..2]));
 }
