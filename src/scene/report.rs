@@ -421,8 +421,9 @@ mod tests {
     /// span may differ by rounding either way, a clearance's witness by anything below it.
     #[test]
     fn distances_agree_within_the_rules_error_and_rounding() {
-        // Large and small distances: the rounding's absolute term matters for the small.
+        // Large and small values: the rounding's absolute term matters for the small.
         for y in [10.0, 0.1] {
+            let rounding = 1e-9 * (1.0 + y);
             let reference = one_pair(1, distance(y));
             let agrees = |x: f64, rel_err: f64| {
                 let effect = |_: ObjectId, _: ObjectId| Effect::Distance {
@@ -433,7 +434,6 @@ mod tests {
                     .disagreement(&reference, effect)
                     .is_none()
             };
-            let rounding = 1e-9 * (1.0 + y);
             for rel_err in [0.0, 0.01] {
                 let top = y * (1.0 + rel_err);
                 assert!(agrees(top + 0.9 * rounding, rel_err));
@@ -441,17 +441,13 @@ mod tests {
                 assert!(agrees(y - 0.9 * rounding, rel_err));
                 assert!(!agrees(y - 1.1 * rounding, rel_err));
             }
-        }
-        let (y, reference) = (10.0, one_pair(1, distance(10.0)));
-        // Spans agree to rounding only, small ones to the absolute term.
-        for y in [y, 0.1] {
+            // Spans agree to rounding only.
             let span = one_pair(1, Answer::Span(y));
             let spans_agree = |x: f64| {
                 one_pair(1, Answer::Span(x))
                     .disagreement(&span, |_, _| Effect::Span)
                     .is_none()
             };
-            let rounding = 1e-9 * (1.0 + y);
             assert!(spans_agree(y + 0.9 * rounding) && spans_agree(y - 0.9 * rounding));
             assert!(!spans_agree(y + 1.1 * rounding) && !spans_agree(y - 1.1 * rounding));
         }
@@ -475,10 +471,11 @@ mod tests {
             .is_some());
         // Another pair, or another kind of answer, disagrees whatever the distances.
         let effect = |_: ObjectId, _: ObjectId| Effect::Span;
-        assert!(one_pair(2, distance(y))
+        let reference = one_pair(1, distance(10.0));
+        assert!(one_pair(2, distance(10.0))
             .disagreement(&reference, effect)
             .is_some());
-        assert!(one_pair(1, Answer::Span(y))
+        assert!(one_pair(1, Answer::Span(10.0))
             .disagreement(&reference, effect)
             .is_some());
     }
