@@ -40,16 +40,22 @@ impl Feature {
 /// segment or point it spans), the nearest of its edges' closest points and its plane's
 /// projection if inside. Never NaN for finite input.
 pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
+    by_regions(p, t).unwrap_or_else(|| nearest_of_edges_and_face(p, t))
+}
+
+/// Ericson's region tests, or `None` where they cannot be trusted: their products cancel
+/// to below `1 / ILL_CONDITIONED` of their size, or the triangle has no area.
+fn by_regions(p: &Vector3<f64>, t: &Triangle) -> Option<(Vector3<f64>, Feature)> {
     let [a, b, c] = t;
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
     if d1 <= 0.0 && d2 <= 0.0 {
-        return (*a, Feature::Vertex(0));
+        return Some((*a, Feature::Vertex(0)));
     }
     let bp = p - b;
     let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
     if d3 >= 0.0 && d4 <= d3 {
-        return (*b, Feature::Vertex(1));
+        return Some((*b, Feature::Vertex(1)));
     }
     let cp = p - c;
     let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
@@ -63,28 +69,25 @@ pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64
         + (d1 * d6).abs()
         + (d3 * d6).abs()
         + (d5 * d4).abs();
-    if (va + vb + vc) * ILL_CONDITIONED < size {
-        return nearest_of_edges_and_face(p, t);
+    let sum = va + vb + vc;
+    if sum * ILL_CONDITIONED < size {
+        return None;
     }
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0 {
-        return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
+        return Some((a + ab * (d1 / (d1 - d3)), Feature::Edge(0)));
     }
     if d6 >= 0.0 && d5 <= d6 {
-        return (*c, Feature::Vertex(2));
+        return Some((*c, Feature::Vertex(2)));
     }
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0 {
-        return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
+        return Some((a + ac * (d2 / (d2 - d6)), Feature::Edge(2)));
     }
     let (e4, e5) = (d4 - d3, d5 - d6);
     if va <= 0.0 && e4 >= 0.0 && e5 >= 0.0 && e4 + e5 > 0.0 {
-        return (b + (c - b) * (e4 / (e4 + e5)), Feature::Edge(1));
+        return Some((b + (c - b) * (e4 / (e4 + e5)), Feature::Edge(1)));
     }
-    let sum = va + vb + vc;
-    if sum > 0.0 && sum.is_finite() {
-        let (v, w) = (vb / sum, vc / sum);
-        return (a + ab * v + ac * w, Feature::Face);
-    }
-    nearest_of_edges_and_face(p, t)
+    let (v, w) = (vb / sum, vc / sum);
+    (sum > 0.0 && sum.is_finite()).then(|| (a + ab * v + ac * w, Feature::Face))
 }
 
 /// Where [`closest_point_on_triangle`]'s region tests cancel: `size / sum` of their
@@ -166,5 +169,38 @@ fn closest_on_segment(
         (*e, Feature::Vertex((k + 1) % 3))
     } else {
         (s + d * along, Feature::Edge(k))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sliver 0.01 long whose apex stands `height` above its longest edge, and a point
+    /// over its face with all six of the guard's products between a tenth and a quarter of
+    /// their sum.
+    fn over_a_sliver(height: f64) -> (Vector3<f64>, Triangle) {
+        let t = [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(0.01, 0.0, 0.0),
+            Vector3::new(0.008, height, 0.0),
+        ];
+        (Vector3::new(0.004, height / 3.0, 0.001), t)
+    }
+
+    #[test]
+    fn the_region_tests_give_way_where_their_products_cancel_as_the_guard_says() {
+        // Their products' size over what is left of them is about 1.06 * 2^20 at the first
+        // height and 0.94 * 2^20 at the second: a guard that measures less of the products
+        // (or more) than it says keeps the region tests on the first (or drops them on
+        // the second).
+        for (height, trusted) in [(9.6e-6, false), (1.02e-5, true)] {
+            let (p, t) = over_a_sliver(height);
+            assert_eq!(by_regions(&p, &t).is_some(), trusted, "height {height}");
+            // Either way the answer is the point below `p`.
+            let (q, feature) = closest_point_on_triangle(&p, &t);
+            assert_eq!(feature, Feature::Face);
+            assert!((q - Vector3::new(p.x, p.y, 0.0)).norm() < 1e-15, "{q:?}");
+        }
     }
 }
