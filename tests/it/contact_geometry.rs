@@ -50,6 +50,51 @@ fn a_crossing_pair_meets_along_its_known_segment() {
     assert!(triangle_intersection(&a, &far).is_none());
 }
 
+/// A corner exactly on the other triangle's plane, inside it, the triangle's other two
+/// corners to one side: they meet at that corner, and the answer is it to the bit (the
+/// module's promise), though the other triangle's section through it is computed and
+/// rounded. Corners on a 1/1024 grid and a point at sixty-fourths of its edges, kept only
+/// where the predicates find it on the plane exactly.
+#[test]
+fn a_corner_touching_a_face_is_where_they_meet_exactly() {
+    let mut rng = Rng::new(5);
+    let mut unit = || rng.unit();
+    let mut touching = 0;
+    for _ in 0..100_000 {
+        let grid = |x: f64| ((2.0 * x - 1.0) * 1024.0).round() / 1024.0;
+        let a: Triangle = [0, 1, 2].map(|_| v(grid(unit()), grid(unit()), grid(unit())));
+        let (s, t) = (
+            (16.0 * unit()).floor() / 64.0,
+            (16.0 * unit()).floor() / 64.0,
+        );
+        let corner = a[0] + (a[1] - a[0]) * s + (a[2] - a[0]) * t;
+        let normal = (a[1] - a[0]).cross(&(a[2] - a[0])).normalize();
+        let off = v(unit() - 0.5, unit() - 0.5, unit() - 0.5);
+        let b: Triangle = [
+            corner,
+            corner + normal * 0.5 + off,
+            corner + normal * 0.7 - off,
+        ];
+        let side = |p: &Vector3<f64>| {
+            let c = |p: &Vector3<f64>| robust::Coord3D {
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            };
+            robust::orient3d(c(&a[0]), c(&a[1]), c(&a[2]), c(p))
+        };
+        if side(&corner) != 0.0 || side(&b[1]) * side(&b[2]) <= 0.0 {
+            continue;
+        }
+        touching += 1;
+        for (x, y) in [(&a, &b), (&b, &a)] {
+            let meet = triangle_intersection(x, y).expect("they touch");
+            assert_eq!(meet.points(), &[corner, corner], "{a:?} {b:?}");
+        }
+    }
+    assert!(touching > 1000, "{touching}");
+}
+
 /// Triangles that meet at one point where an edge of each crosses the other's plane, their
 /// chords along the planes' common line meeting end to end: the cut is that point. Each
 /// edge crosses a third of its way along, so each chord's end is rounded on its own; with

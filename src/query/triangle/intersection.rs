@@ -119,6 +119,16 @@ pub fn triangle_intersection(a: &Triangle, b: &Triangle) -> Option<TriangleInter
     let (Some(sa), Some(sb)) = (section(a, &side_a), section(b, &side_b)) else {
         return Some(single());
     };
+    // A section of one point (a corner on the other's plane, the rest to one side) holds
+    // all the triangles share: that corner, exact, whatever the other section rounds to.
+    if let Some([p, _]) = [sa, sb].into_iter().find(|[p, q]| p == q) {
+        return Some(TriangleIntersection::new(
+            IntersectionKind::Segment,
+            &[p, p],
+            a,
+            b,
+        ));
+    }
     // Both sections lie on the line where the planes meet: keep their overlap.
     let normal = |t: &Triangle| (t[1] - t[0]).cross(&(t[2] - t[0]));
     let line = normal(a).cross(&normal(b));
