@@ -149,6 +149,24 @@ fn coplanar_pairs_share_their_overlap_polygon() {
     );
 }
 
+/// A corner of one coplanar triangle exactly on the line of the other's edge is a corner of
+/// their polygon once: no crossing is made there, which would land near the corner, not on
+/// it (`0.7 + (0.1 - 0.7)` is not `0.1`), and stay beside it as a corner of its own.
+#[test]
+fn a_corner_on_an_edge_line_is_one_corner_of_the_shared_polygon() {
+    let b: Triangle = [v(-10.0, 0.0, 0.0), v(10.0, 0.0, 0.0), v(0.0, 10.0, 0.0)];
+    // The corner before it inside `b`: the polygon is `a` itself.
+    let inside: Triangle = [v(0.7, 1.0, 0.0), v(0.1, 0.0, 0.0), v(2.0, 1.5, 0.0)];
+    let meet = triangle_intersection(&inside, &b).expect("they overlap");
+    assert_eq!(meet.points(), &inside);
+    // The corner before it outside: that edge is cut off, the corner stays.
+    let across: Triangle = [v(0.7, -1.0, 0.0), v(0.1, 0.0, 0.0), v(2.0, 1.5, 0.0)];
+    let meet = triangle_intersection(&across, &b).expect("they overlap");
+    let points = meet.points();
+    assert_eq!(points.len(), 3, "{points:?}");
+    assert_eq!(points[..2], across[1..]);
+}
+
 /// Where the edges of one triangle pierce the other, both ways: for a generic crossing
 /// pair, the two ends of their intersection segment. Computed apart from the library, by
 /// solving each edge against the other triangle's plane and testing barycentrics.
