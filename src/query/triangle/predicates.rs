@@ -361,6 +361,59 @@ mod tests {
         assert!(decided_by_rounding > 100, "{decided_by_rounding}");
     }
 
+    /// orient3d's filter term by term: `d` straight above one of the other three points
+    /// leaves only that point's term of the determinant, and the other two, nearly
+    /// collinear with `d` seen from above, make its 2 × 2 minor cancel to rounding. The
+    /// filter must hand every case it cannot certify to the exact routine.
+    #[test]
+    fn orient3d_is_exact_where_one_term_is_left_and_cancels() {
+        let mut rng = crate::generate::Rng::new(12);
+        let mut unit = || rng.unit();
+        let coordinate = |u: f64| 400.0 * u - 200.0;
+        let mut decided_by_rounding = [0; 3];
+        for _ in 0..20_000 {
+            let base = V::new(coordinate(unit()), coordinate(unit()), coordinate(unit()));
+            let along = V::new(coordinate(unit()), coordinate(unit()), coordinate(unit()));
+            let s = 2.0 * unit() - 0.5;
+            let (lift, height) = (coordinate(unit()), coordinate(unit()));
+            // `d`, and the other two on a line through it in x and y (up to rounding).
+            let d = V::new(base.x, base.y, base.z + height);
+            let on_line = [
+                base + along,
+                V::new(base.x + s * along.x, base.y + s * along.y, base.z + lift),
+            ];
+            for (above, decided) in decided_by_rounding.iter_mut().enumerate() {
+                // `d` straight above point `above` of `a, b, c`.
+                let mut abc = [on_line[0]; 3];
+                abc[above] = base;
+                abc[(above + 2) % 3] = on_line[1];
+                let [a, b, c] = abc;
+                let p = |v: &V| Coord3D {
+                    x: v.x,
+                    y: v.y,
+                    z: v.z,
+                };
+                let exact = robust::orient3d(p(&a), p(&b), p(&c), p(&d));
+                let filtered = orient3d(&a, &b, &c, &d);
+                assert_eq!(
+                    filtered.partial_cmp(&0.0),
+                    exact.partial_cmp(&0.0),
+                    "{abc:?} {d:?}"
+                );
+                let (e, f) = (abc[(above + 1) % 3] - d, abc[(above + 2) % 3] - d);
+                let rounded = (abc[above].z - d.z) * (e.x * f.y - f.x * e.y);
+                if rounded.partial_cmp(&0.0) != exact.partial_cmp(&0.0) {
+                    *decided += 1;
+                }
+            }
+        }
+        // The cases exist for each term: rounding alone gives many of them the wrong sign.
+        assert!(
+            decided_by_rounding.iter().all(|&n| n > 100),
+            "{decided_by_rounding:?}"
+        );
+    }
+
     #[test]
     fn orient3d_sign_convention() {
         let o = V::zeros();
