@@ -167,6 +167,26 @@ fn a_corner_on_an_edge_line_is_one_corner_of_the_shared_polygon() {
     assert_eq!(points[..2], across[1..]);
 }
 
+/// Coplanar triangles that only touch share a segment or a point: their polygon is that
+/// segment's two ends or that one point, each once, though clipping meets them twice.
+#[test]
+fn coplanar_triangles_touching_along_an_edge_or_at_a_corner_share_it_once() {
+    let a: Triangle = [v(-0.5, 0.25, 0.0), v(0.75, 0.25, 0.0), v(0.75, 0.0, 0.0)];
+    let b: Triangle = [v(0.5, 1.0, 0.0), v(0.5, 0.25, 0.0), v(-0.25, 0.25, 0.0)];
+    let ends = [v(-0.25, 0.25, 0.0), v(0.5, 0.25, 0.0)];
+    let corner: Triangle = [v(0.75, 0.0, 0.0), v(1.0, 0.0, 0.0), v(1.0, -1.0, 0.0)];
+    for (x, y, shared) in [(&a, &b, &ends[..]), (&a, &corner, &[corner[0]][..])] {
+        for (x, y) in [(x, y), (y, x)] {
+            let meet = triangle_intersection(x, y).expect("they touch");
+            assert_eq!(meet.kind, IntersectionKind::Polygon);
+            let mut points = meet.points().to_vec();
+            points.sort_by(|p, q| p.x.total_cmp(&q.x));
+            assert_eq!(points, shared, "{x:?} {y:?}");
+            assert_eq!(meet.area(), 0.0);
+        }
+    }
+}
+
 /// Where the edges of one triangle pierce the other, both ways: for a generic crossing
 /// pair, the two ends of their intersection segment. Computed apart from the library, by
 /// solving each edge against the other triangle's plane and testing barycentrics.
