@@ -203,4 +203,22 @@ mod tests {
             assert!((q - Vector3::new(p.x, p.y, 0.0)).norm() < 1e-15, "{q:?}");
         }
     }
+
+    #[test]
+    fn a_triangle_with_two_equal_corners_is_its_segment() {
+        let (a, c) = (Vector3::new(0.0, 0.0, 0.0), Vector3::new(1.0, 0.0, 0.0));
+        let p = Vector3::new(0.5, 1.0, 0.0);
+        for t in [
+            [a, a, c],
+            [a, c, c],
+            [a, c, a],
+            [c, a, a],
+            [c, c, a],
+            [c, a, c],
+        ] {
+            let (q, feature) = closest_point_on_triangle(&p, &t);
+            assert_eq!(q, Vector3::new(0.5, 0.0, 0.0), "{t:?}");
+            assert!(matches!(feature, Feature::Edge(_)), "{feature:?} on {t:?}");
+        }
+    }
 }
