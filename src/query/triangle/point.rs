@@ -1,5 +1,6 @@
 //! The closest point of a triangle to a point, and the feature it lies on.
 
+use super::predicates::{in_range, pow2};
 use super::Triangle;
 use nalgebra::Vector3;
 
@@ -40,11 +41,27 @@ impl Feature {
 /// segment or point it spans), the nearest of its edges' closest points and its plane's
 /// projection if inside. Never NaN for finite input.
 pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
+    // The region tests multiply four coordinate differences, which underflow or overflow
+    // outside the predicates' range: such a triangle is solved about `p`, scaled by a power
+    // of two (exact) to differences in [1, 2).
+    let m = t.iter().map(|v| (v - p).amax()).fold(0.0, f64::max);
+    if in_range(m) || !m.is_finite() {
+        return closest_in_range(p, t);
+    }
+    let e = m.log2().floor() as i32;
+    let local = t.map(|v| (v - p) * pow2(-e));
+    let (q, feature) = closest_in_range(&Vector3::zeros(), &local);
+    (p + q * pow2(e), feature)
+}
+
+/// [`closest_point_on_triangle`] for coordinate differences in the predicates' range.
+fn closest_in_range(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
     by_regions(p, t).unwrap_or_else(|| nearest_of_edges_and_face(p, t))
 }
 
-/// Ericson's region tests, or `None` where they cannot be trusted: their products cancel
-/// to below `1 / ILL_CONDITIONED` of their size, or the triangle has no area.
+/// Ericson's region tests, or `None` where they cannot be trusted (unless a corner's test
+/// answers first): their products cancel to within `1 / ILL_CONDITIONED` of their size (a
+/// sliver, or a triangle of no area, where both are zero).
 fn by_regions(p: &Vector3<f64>, t: &Triangle) -> Option<(Vector3<f64>, Feature)> {
     let [a, b, c] = t;
     let (ab, ac, ap) = (b - a, c - a, p - a);
@@ -70,7 +87,7 @@ fn by_regions(p: &Vector3<f64>, t: &Triangle) -> Option<(Vector3<f64>, Feature)>
         + (d3 * d6).abs()
         + (d5 * d4).abs();
     let sum = va + vb + vc;
-    if sum * ILL_CONDITIONED < size {
+    if sum * ILL_CONDITIONED <= size {
         return None;
     }
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0 {
@@ -177,8 +194,8 @@ mod tests {
     use super::*;
 
     /// A sliver 0.01 long whose apex stands `height` above its longest edge, and a point
-    /// over its face with all six of the guard's products between a tenth and a quarter of
-    /// their sum.
+    /// over its face with each of the guard's six products between an eighth and a fifth of
+    /// their total, `size`.
     fn over_a_sliver(height: f64) -> (Vector3<f64>, Triangle) {
         let t = [
             Vector3::new(0.0, 0.0, 0.0),
@@ -219,6 +236,30 @@ mod tests {
             let (q, feature) = closest_point_on_triangle(&p, &t);
             assert_eq!(q, Vector3::new(0.5, 0.0, 0.0), "{t:?}");
             assert!(matches!(feature, Feature::Edge(_)), "{feature:?} on {t:?}");
+        }
+    }
+
+    #[test]
+    fn a_triangle_far_below_or_above_unit_size_gets_its_nearest_point() {
+        // Across 1e-300 to 1e300: the region tests' products of four differences would be
+        // zero or infinite, and once were, giving a corner or an edge for a face point.
+        for s in [1e-300, 1e-160, 1e-100, 1e-80, 1e80, 1e150, 1e300] {
+            let t = [
+                Vector3::new(0.0, 0.0, 0.0),
+                Vector3::new(s, 0.0, 0.0),
+                Vector3::new(0.0, s, 0.0),
+            ];
+            for (p, nearest, expected) in [
+                ([0.25, 0.25, 0.5], [0.25, 0.25, 0.0], Feature::Face),
+                ([0.5, -1.0, 0.0], [0.5, 0.0, 0.0], Feature::Edge(0)),
+                ([-1.0, -1.0, 3.0], [0.0, 0.0, 0.0], Feature::Vertex(0)),
+            ] {
+                let p = Vector3::from(p) * s;
+                let (q, feature) = closest_point_on_triangle(&p, &t);
+                assert_eq!(feature, expected, "{s:e}");
+                let error = (q - Vector3::from(nearest) * s).amax() / s;
+                assert!(error <= 1e-15, "{s:e}: {q:?}");
+            }
         }
     }
 }

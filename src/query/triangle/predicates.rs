@@ -137,7 +137,7 @@ pub(crate) fn in_range(m: f64) -> bool {
 }
 
 /// `2^k` for `k` in `-1022..=1023`.
-fn pow2(k: i32) -> f64 {
+pub(crate) fn pow2(k: i32) -> f64 {
     f64::from_bits(((k.clamp(-1022, 1023) + 1023) as u64) << 52)
 }
 
