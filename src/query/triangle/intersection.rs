@@ -119,8 +119,9 @@ pub fn triangle_intersection(a: &Triangle, b: &Triangle) -> Option<TriangleInter
     let (Some(sa), Some(sb)) = (section(a, &side_a), section(b, &side_b)) else {
         return Some(single());
     };
-    // A section of one point (a corner on the other's plane, the rest to one side) holds
-    // all the triangles share: that corner, exact, whatever the other section rounds to.
+    // A section of one point (a corner on the other's plane, the rest to one side, or two
+    // crossings rounded together) holds all the triangles share: that point, taken as it
+    // is, whatever the other section rounds to.
     if let Some([p, _]) = [sa, sb].into_iter().find(|[p, q]| p == q) {
         return Some(TriangleIntersection::new(
             IntersectionKind::Segment,
