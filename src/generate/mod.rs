@@ -68,7 +68,7 @@ pub enum GenerateError {
         "the shape would have {count} triangles; at most {MAX_GENERATED_TRIANGLES} are generated"
     )]
     TooManyTriangles {
-        /// The triangles asked for.
+        /// The triangles asked for (`u64::MAX` for that many or more).
         count: u64,
     },
     /// More poses than [`MAX_POSES`].

@@ -24,7 +24,7 @@ pub fn lat_long_sphere(radius: f64, stacks: u32, slices: u32) -> Result<TriMesh,
     positive("radius", radius)?;
     at_least("stacks", stacks, 2)?;
     at_least("slices", slices, 3)?;
-    triangle_count(2 * u64::from(slices) * u64::from(stacks - 1))?;
+    triangle_count(pairs(slices, stacks - 1))?;
     let mut vertices = vec![[0.0, 0.0, radius]];
     for i in 1..stacks {
         let theta = PI * f64::from(i) / f64::from(stacks);
@@ -78,7 +78,7 @@ pub fn plate(size: [f64; 2], cells: [u32; 2]) -> Result<TriMesh, GenerateError> 
     at_least("cells along x", cells[0], 1)?;
     at_least("cells along y", cells[1], 1)?;
     let [nx, ny] = cells;
-    triangle_count(2 * u64::from(nx) * u64::from(ny))?;
+    triangle_count(pairs(nx, ny))?;
     // Cell `k` of `n` starts at (k − n/2) cells from the centre: exact for whole-number
     // cell sizes, so a plate of n cells of size 1 has integer and half-integer corners.
     let coordinate =
@@ -194,6 +194,12 @@ fn at_least(name: &'static str, count: u32, least: u32) -> Result<(), GenerateEr
 /// while it is written (the loaders' cap, 2^28, would take some 25 GB).
 pub const MAX_GENERATED_TRIANGLES: u64 = 1 << 24;
 
+/// Two triangles for each of `a × b` quads, saturating: with both near `u32::MAX` the count
+/// does not fit in a `u64`, and a wrapped one could pass the limit.
+fn pairs(a: u32, b: u32) -> u64 {
+    u64::from(a).saturating_mul(u64::from(b)).saturating_mul(2)
+}
+
 fn triangle_count(count: u64) -> Result<(), GenerateError> {
     if count <= MAX_GENERATED_TRIANGLES {
         Ok(())
@@ -272,6 +278,10 @@ mod tests {
         assert!(matches!(
             plate([1.0, 1.0], [5000, 5000]),
             Err(GenerateError::TooManyTriangles { .. })
+        ));
+        assert!(matches!(
+            plate([1.0, 1.0], [u32::MAX, u32::MAX]),
+            Err(GenerateError::TooManyTriangles { count: u64::MAX })
         ));
     }
 }
