@@ -388,12 +388,7 @@ mod tests {
                 abc[above] = base;
                 abc[(above + 2) % 3] = on_line[1];
                 let [a, b, c] = abc;
-                let p = |v: &V| Coord3D {
-                    x: v.x,
-                    y: v.y,
-                    z: v.z,
-                };
-                let exact = robust::orient3d(p(&a), p(&b), p(&c), p(&d));
+                let exact = orient3d_adaptive(&a, &b, &c, &d);
                 let filtered = orient3d(&a, &b, &c, &d);
                 assert_eq!(
                     filtered.partial_cmp(&0.0),
