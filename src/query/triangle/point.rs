@@ -41,18 +41,29 @@ impl Feature {
 /// segment or point it spans), the nearest of its edges' closest points and its plane's
 /// projection if inside. Never NaN for finite input.
 pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
-    // The region tests multiply four coordinate differences, which underflow or overflow
-    // outside the predicates' range: such a triangle is solved about `p`, scaled by a power
-    // of two (exact) to differences in [1, 2).
-    let m = t.iter().map(|v| (v - p).amax()).fold(0.0, f64::max);
-    if in_range(m) || !m.is_finite() {
+    // The region tests multiply pairs of dot products of the edges with differences to `p`
+    // (the fallback squares those differences): out of the predicates' range these
+    // underflow or overflow, and the triangle is solved about `p`, scaled by a power of two
+    // (exact) to edges of unit size, or smaller where `p` would then be too far for squares.
+    let reach = t.iter().map(|v| (v - p).amax()).fold(0.0, f64::max);
+    let extent = (t[1] - t[0]).amax().max((t[2] - t[0]).amax());
+    if in_range(reach) && in_range(extent) {
         return closest_in_range(p, t);
     }
-    let e = m.log2().floor() as i32;
-    let local = t.map(|v| (v - p) * pow2(-e));
+    let exponent = |x: f64| x.log2().floor() as i32;
+    // A triangle of one point has extent 0, whose exponent saturates to `i32::MIN`.
+    let e = exponent(extent).max(exponent(reach) - MAX_REACH_EXPONENT);
+    // Two factors each way, as in `rescale`: a subnormal extent needs one beyond 2^1023.
+    let down = |v: Vector3<f64>| v * pow2(-e / 2) * pow2(-e - (-e / 2));
+    let up = pow2(e / 2) * pow2(e - e / 2);
+    let local = t.map(|v| down(v - p));
     let (q, feature) = closest_in_range(&Vector3::zeros(), &local);
-    (p + q * pow2(e), feature)
+    (p + q * up, feature)
 }
+
+/// The scaled differences to the query point stay below `2^(MAX_REACH_EXPONENT + 1)`, about
+/// `2e149`, so that their squares (and products of dot products with unit edges) are finite.
+const MAX_REACH_EXPONENT: i32 = 495;
 
 /// [`closest_point_on_triangle`] for coordinate differences in the predicates' range.
 fn closest_in_range(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
@@ -79,7 +90,7 @@ fn by_regions(p: &Vector3<f64>, t: &Triangle) -> Option<(Vector3<f64>, Feature)>
     let (vc, vb, va) = (d1 * d4 - d3 * d2, d5 * d2 - d1 * d6, d3 * d6 - d5 * d4);
     // The region tests subtract products of nearly equal size on a sliver: when what is
     // left is small against them (about 2^-20), rounding can pick a wrong region, and the
-    // nearest of the edges and the face is taken instead.
+    // nearest of the edges and the face is taken instead. Past this guard `sum` is positive.
     let size = (d1 * d4).abs()
         + (d3 * d2).abs()
         + (d5 * d2).abs()
@@ -104,7 +115,7 @@ fn by_regions(p: &Vector3<f64>, t: &Triangle) -> Option<(Vector3<f64>, Feature)>
         return Some((b + (c - b) * (e4 / (e4 + e5)), Feature::Edge(1)));
     }
     let (v, w) = (vb / sum, vc / sum);
-    (sum > 0.0 && sum.is_finite()).then(|| (a + ab * v + ac * w, Feature::Face))
+    Some((a + ab * v + ac * w, Feature::Face))
 }
 
 /// Where [`closest_point_on_triangle`]'s region tests cancel: `size / sum` of their
@@ -146,16 +157,11 @@ fn face_projection(p: &Vector3<f64>, t: &Triangle) -> Option<Vector3<f64>> {
         })?;
     let edge = e - s;
     let l2 = edge.norm_squared();
-    if !(l2 > 0.0 && l2.is_finite()) {
-        return None;
-    }
-    // The apex's foot on the longest edge's line, and the unit direction up to it.
+    // The apex's foot on the longest edge's line, and the unit direction up to it. A triangle
+    // of no height (or of one point) makes them NaN, which the test of `mu` below refuses.
     let along_r = (r - s).dot(&edge) / l2;
     let up = r - (s + edge * along_r);
     let height = up.norm();
-    if !(height > 0.0 && height.is_finite()) {
-        return None;
-    }
     let up = up / height;
     let along = (p - s).dot(&edge) / l2;
     let across = (p - s).dot(&up);
@@ -222,6 +228,24 @@ mod tests {
     }
 
     #[test]
+    fn a_point_over_a_flat_sliver_is_over_its_face_in_every_corner_order() {
+        // Slivers whose region tests cancel: the plane is taken from the longest edge. From
+        // a shorter one the apex's foot falls far along it, rounded by about as much as the
+        // height, and the point was found outside.
+        for (apex, height) in [(0.3, 1e-9), (0.8, 1e-9), (0.8, 1e-12)] {
+            let [a, b, c] = [[2.0, 0.0, 0.0], [3.0, 0.0, 0.0], [2.0 + apex, height, 0.0]];
+            let p = Vector3::new(2.05 + 0.9 * apex, height / 3.0, 1.0);
+            for t in [[a, b, c], [b, c, a], [c, a, b]] {
+                let t = t.map(Vector3::from);
+                assert!(by_regions(&p, &t).is_none(), "{t:?}");
+                let (q, feature) = closest_point_on_triangle(&p, &t);
+                assert_eq!(feature, Feature::Face, "{t:?}");
+                assert!((q - Vector3::new(p.x, p.y, 0.0)).amax() <= 1e-15, "{q:?}");
+            }
+        }
+    }
+
+    #[test]
     fn a_triangle_with_two_equal_corners_is_its_segment() {
         let (a, c) = (Vector3::new(0.0, 0.0, 0.0), Vector3::new(1.0, 0.0, 0.0));
         let p = Vector3::new(0.5, 1.0, 0.0);
@@ -260,6 +284,55 @@ mod tests {
                 let error = (q - Vector3::from(nearest) * s).amax() / s;
                 assert!(error <= 1e-15, "{s:e}: {q:?}");
             }
+        }
+    }
+
+    #[test]
+    fn a_tiny_triangle_is_scaled_by_its_own_size_and_its_distance_to_the_point() {
+        // Triangles in a plane x = constant, and points either in that plane 2^-196 from
+        // the origin (the coordinates' sums are in the predicates' range, the differences the
+        // products are made of are not) or 1 above it (the differences to the point are in
+        // range, the edges are not). Once only the first, and then only the differences to
+        // the point, were measured; errors reached 2.5e-4 of the triangle at 1e-80.
+        let x = pow2(-196);
+        for (plane, above) in [(x, 0.0), (0.0, 1.0)] {
+            for s in [1e-300, 1e-140, 1e-80, 1e-79] {
+                // Below 1e-149 of its distance a triangle is solved to within its size only,
+                // far below the distance's rounding.
+                let exact = above == 0.0 || s >= 1e-140;
+                let t = [[plane, 0.0, 0.0], [plane, s, 0.0], [plane, 0.0, s]].map(Vector3::from);
+                for (p, nearest, expected) in [
+                    ([0.25, 0.25], [0.25, 0.25], Feature::Face),
+                    ([0.5, -1.0], [0.5, 0.0], Feature::Edge(0)),
+                    ([-1.0, -1.0], [0.0, 0.0], Feature::Vertex(0)),
+                ] {
+                    let p = Vector3::new(plane + above, p[0] * s, p[1] * s);
+                    let (q, feature) = closest_point_on_triangle(&p, &t);
+                    let nearest = Vector3::new(plane, nearest[0] * s, nearest[1] * s);
+                    let error = (q - nearest).amax();
+                    if exact {
+                        assert_eq!(feature, expected, "{s:e} {above}");
+                        assert!(error <= 1e-15 * s, "{s:e} {above}: {q:?}");
+                    } else {
+                        assert!(error <= s, "{s:e} {above}: {q:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_point_far_beyond_an_edge_of_a_tilted_triangle_gets_a_point_of_it() {
+        // In the triangle's plane, beyond edge 1: each edge times the difference to `p` is
+        // about `far`, and their products would overflow unscaled (NaN, once). So far away
+        // rounding leaves no trace of where `p` is beside the triangle: any of its points is
+        // nearest, to the distance's last bit.
+        let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 1.0]].map(Vector3::from);
+        for far in [1e160, 1e300] {
+            let p = Vector3::new(2.0 * far, far, far);
+            let (q, _) = closest_point_on_triangle(&p, &t);
+            let in_box = q.iter().all(|&x| (0.0..=1.0).contains(&x));
+            assert!(in_box && q.y == q.z, "{far:e}: {q:?}");
         }
     }
 }
