@@ -172,7 +172,8 @@ fn face_projection(p: &Vector3<f64>, t: &Triangle) -> Option<Vector3<f64>> {
     inside.then(|| s + edge * along + up * across)
 }
 
-/// The point of segment `s → e` (edge `k` of its triangle) closest to `p`.
+/// The point of segment `s → e` (edge `k` of its triangle) closest to `p`; NaN for a segment
+/// of no length.
 fn closest_on_segment(
     p: &Vector3<f64>,
     s: &Vector3<f64>,
@@ -180,13 +181,10 @@ fn closest_on_segment(
     k: u8,
 ) -> (Vector3<f64>, Feature) {
     let d = e - s;
-    let length2 = d.norm_squared();
-    let along = if length2 > 0.0 {
-        (p - s).dot(&d) / length2
-    } else {
-        0.0
-    };
-    if along <= 0.0 || along.is_nan() {
+    // A segment of no length gives 0 / 0: a NaN point, at a distance no comparison takes
+    // (its corner is another edge's end, or a triangle of one point's first corner).
+    let along = (p - s).dot(&d) / d.norm_squared();
+    if along <= 0.0 {
         (*s, Feature::Vertex(k))
     } else if along >= 1.0 {
         (*e, Feature::Vertex((k + 1) % 3))
@@ -248,7 +246,6 @@ mod tests {
     #[test]
     fn a_triangle_with_two_equal_corners_is_its_segment() {
         let (a, c) = (Vector3::new(0.0, 0.0, 0.0), Vector3::new(1.0, 0.0, 0.0));
-        let p = Vector3::new(0.5, 1.0, 0.0);
         for t in [
             [a, a, c],
             [a, c, c],
@@ -257,10 +254,30 @@ mod tests {
             [c, c, a],
             [c, a, c],
         ] {
-            let (q, feature) = closest_point_on_triangle(&p, &t);
-            assert_eq!(q, Vector3::new(0.5, 0.0, 0.0), "{t:?}");
-            assert!(matches!(feature, Feature::Edge(_)), "{feature:?} on {t:?}");
+            // Beside the segment, and beyond either end: the feature names the corner or
+            // the edge (from corner k to corner k + 1) the point is on.
+            for (p, nearest) in [
+                ([0.5, 1.0, 0.0], [0.5, 0.0, 0.0]),
+                ([2.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+                ([-1.0, 0.5, 0.0], [0.0, 0.0, 0.0]),
+            ] {
+                let (q, feature) = closest_point_on_triangle(&Vector3::from(p), &t);
+                assert_eq!(q, Vector3::from(nearest), "{t:?}");
+                let k = usize::from(feature.index());
+                let on_it = match feature {
+                    Feature::Vertex(_) => t[k] == q,
+                    Feature::Edge(_) => t[k] != t[(k + 1) % 3],
+                    Feature::Face => false,
+                };
+                assert!(on_it, "{feature:?} for {p:?} on {t:?}");
+            }
         }
+        // A triangle of one point is that point.
+        let p = Vector3::new(0.5, 1.0, 0.0);
+        assert_eq!(
+            closest_point_on_triangle(&p, &[c, c, c]),
+            (c, Feature::Vertex(0))
+        );
     }
 
     #[test]
