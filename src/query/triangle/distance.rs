@@ -1,7 +1,7 @@
 //! Minimum and maximum distance between two closed triangles, with witness points.
 
 use super::overlap::{aabb_overlap, intersect_with_planes};
-use super::predicates::{in_range, max_abs, rescale, PlaneSide};
+use super::predicates::{in_range, reach_and_spread, rescale, PlaneSide};
 use super::{Triangle, TriangleDistance};
 use nalgebra::Vector3;
 
@@ -29,25 +29,32 @@ type V = Vector3<f64>;
 /// - **Symmetric:** `triangle_distance(b, a)` returns the same distance bit for bit, with the
 ///   witnesses swapped.
 ///
-/// Never NaN and never panics for finite inputs (pairs whose largest coordinate lies outside
-/// 1e-60..1e60 are solved scaled by a power of two; the distance may then overflow to
+/// Never NaN and never panics for finite inputs (pairs whose largest coordinate, or largest
+/// difference of coordinates along an axis, lies outside 1e-60..1e60 are solved scaled by
+/// a power of two; the distance may then overflow to
 /// infinity near `f64::MAX`); a pair with an infinite corner is at infinite distance. It
 /// always terminates and needs no allocation.
 #[inline]
 pub fn triangle_distance(a: &Triangle, b: &Triangle) -> TriangleDistance {
-    let m = max_abs(a, b);
-    if !in_range(m) {
-        // Rescaling infinity would recurse for ever: a pair with an infinite corner (a
-        // damaged, unverified file, or a pose that overflows) is infinitely far apart.
-        if !m.is_finite() {
+    let (reach, spread) = reach_and_spread(a, b);
+    if !(in_range(reach) && in_range(spread)) {
+        // A pair with an infinite corner (a damaged, unverified file, or a pose that
+        // overflows) is infinitely far apart; it has no scale.
+        if !reach.is_finite() {
             return TriangleDistance {
                 distance: f64::INFINITY,
                 point_a: a[0],
                 point_b: b[0],
             };
         }
-        return distance_rescaled(a, b, m);
+        return distance_rescaled(a, b, reach, spread);
     }
+    distance_in_range(a, b)
+}
+
+/// [`triangle_distance`] of a pair in range, or as far into it as scaling brings it.
+#[inline(always)]
+fn distance_in_range(a: &Triangle, b: &Triangle) -> TriangleDistance {
     // Which pair of witnesses answers first depends on the argument order; solving in a
     // canonical order makes the result exactly symmetric: d(a, b) == d(b, a) bit for bit.
     if precedes(b, a) {
@@ -61,13 +68,13 @@ pub fn triangle_distance(a: &Triangle, b: &Triangle) -> TriangleDistance {
     distance_ordered(a, b)
 }
 
-/// Coordinates so large (or small) that products of differences would overflow (or
-/// underflow): solve the pair scaled by a power of two to magnitude about 1, scale back.
+/// Coordinates or differences so large (or small) that products of differences would
+/// overflow (or underflow): solve the pair scaled by a power of two, scale back.
 #[cold]
 #[inline(never)]
-fn distance_rescaled(a: &Triangle, b: &Triangle, m: f64) -> TriangleDistance {
-    let (a, b, up) = rescale(a, b, m);
-    let r = triangle_distance(&a, &b);
+fn distance_rescaled(a: &Triangle, b: &Triangle, reach: f64, spread: f64) -> TriangleDistance {
+    let (a, b, up) = rescale(a, b, reach, spread);
+    let r = distance_in_range(&a, &b);
     let back = |x: V| x.map(|c| c * up);
     TriangleDistance {
         distance: r.distance * up,

@@ -2,7 +2,7 @@
 //! explicit coplanar and degenerate branches built on the same exact predicates).
 
 use super::predicates::{
-    dominant_axis, in_range, max_abs, orient2d, orient3d, project, rescale, PlaneSide, P2,
+    dominant_axis, in_range, orient2d, orient3d, project, rescale, PlaneSide, P2,
 };
 use super::Triangle;
 use nalgebra::Vector3;
@@ -20,8 +20,9 @@ type V = Vector3<f64>;
 /// The decision uses only the signs of orientation determinants (orient3d, and orient2d on
 /// exact coordinate projections), evaluated exactly with Shewchuk's adaptive arithmetic, so it
 /// is the exact answer for the f64 coordinates given (no tolerance). Pairs whose largest
-/// coordinate lies outside 1e-60..1e60 are first scaled by a power of two (exact), so the
-/// answer stays exact unless the coordinates span hundreds of orders of magnitude. A pair
+/// coordinate, or largest difference of coordinates along an axis, lies outside 1e-60..1e60
+/// are first scaled by a power of two (exact), so the answer stays exact unless the
+/// coordinates span hundreds of orders of magnitude. A pair
 /// with an infinite coordinate does not intersect (NaN corners give an unspecified answer).
 /// It never panics, always terminates and needs no allocation.
 ///
@@ -32,17 +33,16 @@ type V = Vector3<f64>;
 /// sign is too close to call.
 #[inline]
 pub fn triangles_intersect(a: &Triangle, b: &Triangle) -> bool {
-    if !aabb_overlap(a, b) {
+    let Some((reach, spread)) = boxes_meet(a, b) else {
         return false;
-    }
-    let m = max_abs(a, b);
-    if !in_range(m) {
+    };
+    if !(in_range(reach) && in_range(spread)) {
         // An infinite corner (a damaged, unverified file, or a pose that overflows) spans no
         // closed set: no contact. Checked here, since rescaling infinity would never end.
-        if !m.is_finite() {
+        if !reach.is_finite() {
             return false;
         }
-        let (a, b, _) = rescale(a, b, m);
+        let (a, b, _) = rescale(a, b, reach, spread);
         return intersect_in_range(&a, &b);
     }
     intersect_in_range(a, b)
@@ -96,20 +96,31 @@ fn intersect_after_a_plane(a: &Triangle, b: &Triangle, pb: &PlaneSide, db: [f64;
 
 /// Exact and necessary: closed sets that share a point have overlapping closed boxes.
 #[inline(always)]
+pub(crate) fn aabb_overlap(a: &Triangle, b: &Triangle) -> bool {
+    boxes_meet(a, b).is_some()
+}
+
+/// The pair's reach and spread (`predicates::reach_and_spread`) if their closed boxes meet, from
+/// the same bounds per axis.
+#[inline(always)]
 // why: coordinate numbers in 0..3 on fixed-size triangles; the first test of every triangle
 // pair, where the index-free form was measurably slower in collision queries.
 #[allow(clippy::indexing_slicing)]
-pub(crate) fn aabb_overlap(a: &Triangle, b: &Triangle) -> bool {
+fn boxes_meet(a: &Triangle, b: &Triangle) -> Option<(f64, f64)> {
+    let (mut reach, mut spread) = (0.0f64, 0.0f64);
     for k in 0..3 {
         let amin = a[0][k].min(a[1][k]).min(a[2][k]);
         let amax = a[0][k].max(a[1][k]).max(a[2][k]);
         let bmin = b[0][k].min(b[1][k]).min(b[2][k]);
         let bmax = b[0][k].max(b[1][k]).max(b[2][k]);
         if amax < bmin || bmax < amin {
-            return false;
+            return None;
         }
+        let (lo, hi) = (amin.min(bmin), amax.max(bmax));
+        reach = reach.max(-lo).max(hi);
+        spread = spread.max(hi - lo);
     }
-    true
+    Some((reach, spread))
 }
 
 #[inline(always)]
@@ -397,6 +408,7 @@ pub(crate) fn point_in_tri_2d(p: P2, t: &[P2; 3]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::query::triangle::predicates::pow2;
 
     /// The pre-filter of every triangle pair: boxes apart on any one axis, in either order,
     /// reject the pair (a filter that never rejects would leave every answer right and
@@ -557,5 +569,34 @@ mod tests {
         assert!(point_in_tri_2d([2., 2.], &t));
         assert!(point_in_tri_2d([0., 0.], &t));
         assert!(!point_in_tri_2d([2.5, 2.], &t));
+    }
+    /// Small integer configurations, and the same mapped exactly (per axis, a translation and
+    /// a power of two) to a small pair 2^-196 from the origin along x, 2^-248 apart along x
+    /// and 2^-532 along y and z: its coordinates are in the predicates' range, its
+    /// differences far below it. Once only the coordinates were measured, and products of
+    /// those differences underflowed: a third of the answers were wrong.
+    #[test]
+    fn a_small_pair_away_from_the_origin_meets_as_its_unit_image_does() {
+        let mut rng = crate::generate::Rng::new(7);
+        let (x, ux, uyz) = (pow2(-196), pow2(-248), pow2(-532));
+        let mut met = 0;
+        for _ in 0..20_000 {
+            let mut corner = || {
+                let c = [
+                    rng.below(3) as f64 - 1.0,
+                    rng.below(5) as f64,
+                    rng.below(5) as f64,
+                ];
+                (V::from(c), V::new(x + c[0] * ux, c[1] * uyz, c[2] * uyz))
+            };
+            let [(a0, a1), (a2, a3), (a4, a5), (b0, b1), (b2, b3), (b4, b5)] =
+                std::array::from_fn(|_| corner());
+            let unit = triangles_intersect(&[a0, a2, a4], &[b0, b2, b4]);
+            let small = triangles_intersect(&[a1, a3, a5], &[b1, b3, b5]);
+            assert_eq!(small, unit, "{:?}", [a0, a2, a4, b0, b2, b4]);
+            met += usize::from(unit);
+        }
+        // Both answers occur often.
+        assert!((2_000..18_000).contains(&met), "{met}");
     }
 }

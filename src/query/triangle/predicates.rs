@@ -114,23 +114,27 @@ impl PlaneSide {
     }
 }
 
-/// Coordinates whose largest magnitude lies in `[RANGE_LO, RANGE_HI]` (or are all zero) keep
-/// every product the predicates and distance formulas form (up to fourth powers of coordinate
-/// differences, and the tails of Shewchuk's expansions) clear of overflow and underflow.
+/// Two triangles whose coordinates' largest magnitude (`reach`) and largest difference along an
+/// axis (`spread`) both lie in `[RANGE_LO, RANGE_HI]` (or are zero) keep every product the
+/// predicates and distance formulas form (up to fourth powers of coordinate differences, and
+/// the tails of Shewchuk's expansions) clear of overflow and underflow. The spread counts
+/// apart from the reach: coordinates in range can differ by far less, as do those of a small
+/// triangle away from the origin along one axis.
 const RANGE_LO: f64 = 1e-60;
 const RANGE_HI: f64 = 1e60;
 
-/// The largest coordinate magnitude of two triangles.
+/// The `reach` and `spread` of two triangles (see [`RANGE_LO`]), from each axis's least and
+/// greatest coordinate. An overflowing difference makes the spread infinite.
 #[inline(always)]
-pub(crate) fn max_abs(a: &[V; 3], b: &[V; 3]) -> f64 {
-    let mut m = 0.0f64;
-    for p in a.iter().chain(b.iter()) {
-        m = m.max(p.x.abs()).max(p.y.abs()).max(p.z.abs());
-    }
-    m
+pub(crate) fn reach_and_spread(a: &[V; 3], b: &[V; 3]) -> (f64, f64) {
+    let (lo, hi) = a
+        .iter()
+        .chain(b)
+        .fold((a[0], a[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+    ((-lo).max().max(hi.max()), (hi - lo).max())
 }
 
-/// Is `max_abs` inside the safe range (see [`rescale`] otherwise)?
+/// Is a reach or spread inside the safe range (see [`rescale`] otherwise)?
 #[inline(always)]
 pub(crate) fn in_range(m: f64) -> bool {
     (RANGE_LO..=RANGE_HI).contains(&m) || m == 0.0
@@ -141,18 +145,33 @@ pub(crate) fn pow2(k: i32) -> f64 {
     f64::from_bits(((k.clamp(-1022, 1023) + 1023) as u64) << 52)
 }
 
-/// Scales both triangles by the power of two `2^-e` that brings `m = max_abs(a, b)` into
-/// `[1, 2)`, and returns them with `2^e` to scale lengths back. Scaling by a power of two is
-/// exact (the contact answer is unchanged) unless it pushes some coordinate below the normal
-/// range, which only happens for pairs whose coordinates span hundreds of orders of magnitude.
+/// `floor(log2(x))`: saturates to `i32::MIN` for 0 and `i32::MAX` for infinity.
+pub(crate) fn exponent(x: f64) -> i32 {
+    x.log2().floor() as i32
+}
+
+/// `v * 2^-e`, in two factors so that each stays representable (`e` can reach -1074).
+pub(crate) fn scale_down(v: V, e: i32) -> V {
+    v * pow2(-e / 2) * pow2(-e - (-e / 2))
+}
+
+/// `2^e`, which undoes [`scale_down`] on lengths.
+pub(crate) fn scale_up(e: i32) -> f64 {
+    pow2(e / 2) * pow2(e - e / 2)
+}
+
+/// Scales both triangles by a power of two `2^-e` that brings their spread to `[1, 2)` (their
+/// reach to just below `2^199` where that would take it further), and returns them with `2^e`
+/// to scale lengths back. Scaling by a power of two is exact (the contact answer is unchanged)
+/// unless it pushes some coordinate below the normal range, which only happens for pairs whose
+/// coordinates span hundreds of orders of magnitude; so does a spread below `2^-398` of the
+/// reach stay below the range.
 #[cold]
-pub(crate) fn rescale(a: &[V; 3], b: &[V; 3], m: f64) -> ([V; 3], [V; 3], f64) {
-    let e = if m > 0.0 { m.log2().floor() as i32 } else { 0 };
-    // Two factors so that each stays representable (e can reach -1074).
-    let (h1, h2) = (-e / 2, -e - (-e / 2));
-    let (f1, f2) = (pow2(h1), pow2(h2));
-    let scale = |t: &[V; 3]| t.map(|p| p * f1 * f2);
-    (scale(a), scale(b), pow2(e / 2) * pow2(e - e / 2))
+pub(crate) fn rescale(a: &[V; 3], b: &[V; 3], reach: f64, spread: f64) -> ([V; 3], [V; 3], f64) {
+    let r = exponent(reach);
+    let e = exponent(spread).min(r + 1).max(r - 198);
+    let scale = |t: &[V; 3]| t.map(|p| scale_down(p, e));
+    (scale(a), scale(b), scale_up(e))
 }
 
 /// A point of a coordinate plane: two of the three coordinates of a 3D point, taken exactly.
