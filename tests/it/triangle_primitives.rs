@@ -871,7 +871,7 @@ fn exact_on_non_dyadic_coordinates() {
 }
 
 /// Scaling by a power of two is exact, so contact and the (scaled) distance must not change,
-/// from subnormal-adjacent to overflow-adjacent magnitudes.
+/// from subnormal-adjacent to overflow-adjacent magnitudes, on either side of the origin.
 #[test]
 fn power_of_two_scales_change_nothing() {
     let pairs = [
@@ -892,19 +892,19 @@ fn power_of_two_scales_change_nothing() {
     for (a, b) in pairs {
         let hit = triangles_intersect(&a, &b);
         let d = triangle_distance(&a, &b).distance;
-        for k in [-1000, -600, -200, -64, 64, 200, 600, 1000] {
-            let s = 2f64.powi(k);
+        let scales = [-1000, -600, -200, -64, 64, 200, 600, 1000].map(|k| 2f64.powi(k));
+        for s in scales.into_iter().flat_map(|s| [s, -s]) {
             let (sa, sb) = (map(&a, |p| p * s), map(&b, |p| p * s));
-            assert_eq!(triangles_intersect(&sa, &sb), hit, "2^{k}");
+            assert_eq!(triangles_intersect(&sa, &sb), hit, "{s:e}");
             let r = triangle_distance(&sa, &sb);
             assert!(
-                (r.distance - d * s).abs() <= 1e-12 * d * s,
-                "2^{k}: {r:?} vs {d:e}"
+                (r.distance - d * s.abs()).abs() <= 1e-12 * d * s.abs(),
+                "{s:e}: {r:?} vs {d:e}"
             );
             let on = |p: V, t: &Triangle| brute::point_triangle(p / s, &map(t, |q| q / s));
             assert!(
                 on(r.point_a, &sa) <= 1e-12 && on(r.point_b, &sb) <= 1e-12,
-                "2^{k}"
+                "{s:e}"
             );
         }
     }

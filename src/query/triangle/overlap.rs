@@ -571,29 +571,35 @@ mod tests {
         assert!(!point_in_tri_2d([2.5, 2.], &t));
     }
     /// Small integer configurations, and the same mapped exactly (per axis, a translation and
-    /// a power of two) to a small pair 2^-196 from the origin along x, 2^-248 apart along x
-    /// and 2^-532 along y and z: its coordinates are in the predicates' range, its
-    /// differences far below it. Once only the coordinates were measured, and products of
-    /// those differences underflowed: a third of the answers were wrong.
+    /// a power of two, x mirrored or not) to a small pair 2^-196 from the origin along x,
+    /// 2^-248 apart along x and 2^-532 along y and z: its coordinates are in the
+    /// predicates' range, its differences far below it. Once only the coordinates were
+    /// measured, and products of those differences underflowed: a third of the answers were
+    /// wrong. The distance is zero for exactly the pairs that meet.
     #[test]
     fn a_small_pair_away_from_the_origin_meets_as_its_unit_image_does() {
+        use crate::query::triangle::triangle_distance;
         let mut rng = crate::generate::Rng::new(7);
         let (x, ux, uyz) = (pow2(-196), pow2(-248), pow2(-532));
         let mut met = 0;
-        for _ in 0..20_000 {
+        for i in 0..20_000 {
+            let side = if i % 2 == 0 { 1.0 } else { -1.0 };
             let mut corner = || {
                 let c = [
                     rng.below(3) as f64 - 1.0,
                     rng.below(5) as f64,
                     rng.below(5) as f64,
                 ];
-                (V::from(c), V::new(x + c[0] * ux, c[1] * uyz, c[2] * uyz))
+                let small = V::new(side * (x + c[0] * ux), c[1] * uyz, c[2] * uyz);
+                (V::new(side * c[0], c[1], c[2]), small)
             };
             let [(a0, a1), (a2, a3), (a4, a5), (b0, b1), (b2, b3), (b4, b5)] =
                 std::array::from_fn(|_| corner());
             let unit = triangles_intersect(&[a0, a2, a4], &[b0, b2, b4]);
-            let small = triangles_intersect(&[a1, a3, a5], &[b1, b3, b5]);
-            assert_eq!(small, unit, "{:?}", [a0, a2, a4, b0, b2, b4]);
+            let (a, b) = ([a1, a3, a5], [b1, b3, b5]);
+            let at = [a0, a2, a4, b0, b2, b4];
+            assert_eq!(triangles_intersect(&a, &b), unit, "{at:?}");
+            assert_eq!(triangle_distance(&a, &b).distance == 0.0, unit, "{at:?}");
             met += usize::from(unit);
         }
         // Both answers occur often.

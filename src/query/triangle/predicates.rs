@@ -160,16 +160,17 @@ pub(crate) fn scale_up(e: i32) -> f64 {
     pow2(e / 2) * pow2(e - e / 2)
 }
 
-/// Scales both triangles by a power of two `2^-e` that brings their spread to `[1, 2)` (their
+/// Scales both triangles by a power of two `2^-e` that brings their spread to `[1, 4)` (their
 /// reach to just below `2^199` where that would take it further), and returns them with `2^e`
 /// to scale lengths back. Scaling by a power of two is exact (the contact answer is unchanged)
 /// unless it pushes some coordinate below the normal range, which only happens for pairs whose
-/// coordinates span hundreds of orders of magnitude; so does a spread below `2^-398` of the
-/// reach stay below the range.
+/// coordinates span hundreds of orders of magnitude; so does a spread below about `1e-120` of
+/// the reach stay below the range.
 #[cold]
 pub(crate) fn rescale(a: &[V; 3], b: &[V; 3], reach: f64, spread: f64) -> ([V; 3], [V; 3], f64) {
+    // The spread is at most twice the reach, unless it overflowed to infinity.
     let r = exponent(reach);
-    let e = exponent(spread).min(r + 1).max(r - 198);
+    let e = exponent(spread).min(r).max(r - 198);
     let scale = |t: &[V; 3]| t.map(|p| scale_down(p, e));
     (scale(a), scale(b), scale_up(e))
 }
