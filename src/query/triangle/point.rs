@@ -306,13 +306,14 @@ mod tests {
 
     #[test]
     fn a_tiny_triangle_is_scaled_by_its_own_size_and_its_distance_to_the_point() {
-        // Triangles in a plane x = constant, and points either in that plane 2^-196 from
-        // the origin (the coordinates' sums are in the predicates' range, the differences the
-        // products are made of are not) or 1 above it (the differences to the point are in
-        // range, the edges are not). Once only the first, and then only the differences to
-        // the point, were measured; errors reached 2.5e-4 of the triangle at 1e-80.
+        // Triangles in a plane x = constant, and points in that plane 2^-196 from the origin
+        // (the coordinates' sums are in the predicates' range, the differences the products
+        // are made of are not) or 1 above it (the differences to the point are in range, the
+        // edges are not; on the plane 2^-196 out, the edges' sums are in range too). Once
+        // only the first, and then only the differences to the point, were measured; errors
+        // reached 2.5e-4 of the triangle at 1e-80.
         let x = pow2(-196);
-        for (plane, above) in [(x, 0.0), (0.0, 1.0)] {
+        for (plane, above) in [(x, 0.0), (0.0, 1.0), (x, 1.0)] {
             for s in [1e-300, 1e-140, 1e-80, 1e-79] {
                 // Below 1e-149 of its distance a triangle is solved to within its size only,
                 // far below the distance's rounding.
@@ -325,8 +326,12 @@ mod tests {
                 ] {
                     let p = Vector3::new(plane + above, p[0] * s, p[1] * s);
                     let (q, feature) = closest_point_on_triangle(&p, &t);
-                    let nearest = Vector3::new(plane, nearest[0] * s, nearest[1] * s);
-                    let error = (q - nearest).amax();
+                    // Across the plane within the rounding of the distance; in it, within
+                    // that of the triangle (or its size).
+                    assert!((q.x - plane).abs() <= 1e-15 * above, "{s:e} {above}: {q:?}");
+                    let error = (q.y - nearest[0] * s)
+                        .abs()
+                        .max((q.z - nearest[1] * s).abs());
                     if exact {
                         assert_eq!(feature, expected, "{s:e} {above}");
                         assert!(error <= 1e-15 * s, "{s:e} {above}: {q:?}");
