@@ -1,6 +1,6 @@
 //! The closest point of a triangle to a point, and the feature it lies on.
 
-use super::predicates::{in_range, pow2};
+use super::predicates::{exponent, in_range, scale_down, scale_up};
 use super::Triangle;
 use nalgebra::Vector3;
 
@@ -50,15 +50,11 @@ pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64
     if in_range(reach) && in_range(extent) {
         return closest_in_range(p, t);
     }
-    let exponent = |x: f64| x.log2().floor() as i32;
     // A triangle of one point has extent 0, whose exponent saturates to `i32::MIN`.
     let e = exponent(extent).max(exponent(reach) - MAX_REACH_EXPONENT);
-    // Two factors each way, as in `rescale`: a subnormal extent needs one beyond 2^1023.
-    let down = |v: Vector3<f64>| v * pow2(-e / 2) * pow2(-e - (-e / 2));
-    let up = pow2(e / 2) * pow2(e - e / 2);
-    let local = t.map(|v| down(v - p));
+    let local = t.map(|v| scale_down(v - p, e));
     let (q, feature) = closest_in_range(&Vector3::zeros(), &local);
-    (p + q * up, feature)
+    (p + q * scale_up(e), feature)
 }
 
 /// The scaled differences to the query point stay below `2^(MAX_REACH_EXPONENT + 1)`, about
@@ -196,6 +192,7 @@ fn closest_on_segment(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::query::triangle::predicates::pow2;
 
     /// A sliver 0.01 long whose apex stands `height` above its longest edge, and a point
     /// over its face with each of the guard's six products between an eighth and a fifth of
