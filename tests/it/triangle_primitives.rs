@@ -955,6 +955,22 @@ fn extreme_magnitudes_never_nan() {
     }
 }
 
+/// Pairs with no spread (every corner one point) scaled as far as their reach allows: the
+/// witnesses come back where the point is (a single factor of 2^e once rounded them to 0).
+#[test]
+fn a_pair_of_one_point_far_below_unit_size_keeps_its_witnesses() {
+    for x in [1e-270, 1e-300, 5e-324] {
+        let a = [v(x, 0.0, 0.0); 3];
+        let r = triangle_distance(&a, &a);
+        assert_eq!(
+            (r.distance, r.point_a, r.point_b),
+            (0.0, a[0], a[0]),
+            "{x:e}"
+        );
+        assert!(triangles_intersect(&a, &a), "{x:e}");
+    }
+}
+
 /// Regression: a corner at infinity (an unverified, damaged file, or a pose that overflows
 /// huge coordinates) used to make both primitives rescale by 2^-inf and call themselves for
 /// ever (a stack overflow). Infinite pairs do not touch and are infinitely far apart; NaN

@@ -1,7 +1,7 @@
 //! Minimum and maximum distance between two closed triangles, with witness points.
 
 use super::overlap::{aabb_overlap, intersect_with_planes};
-use super::predicates::{in_range, reach_and_spread, rescale, PlaneSide};
+use super::predicates::{in_range, reach_and_spread, rescale, scale_back, PlaneSide};
 use super::{Triangle, TriangleDistance};
 use nalgebra::Vector3;
 
@@ -73,11 +73,11 @@ fn distance_in_range(a: &Triangle, b: &Triangle) -> TriangleDistance {
 #[cold]
 #[inline(never)]
 fn distance_rescaled(a: &Triangle, b: &Triangle, reach: f64, spread: f64) -> TriangleDistance {
-    let (a, b, up) = rescale(a, b, reach, spread);
+    let (a, b, e) = rescale(a, b, reach, spread);
     let r = distance_in_range(&a, &b);
-    let back = |x: V| x.map(|c| c * up);
+    let back = |x: V| x.map(|c| scale_back(c, e));
     TriangleDistance {
-        distance: r.distance * up,
+        distance: scale_back(r.distance, e),
         point_a: back(r.point_a),
         point_b: back(r.point_b),
     }

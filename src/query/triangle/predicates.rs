@@ -115,10 +115,12 @@ impl PlaneSide {
 }
 
 /// Two triangles whose coordinates' largest magnitude (`reach`) and largest difference along an
-/// axis (`spread`) both lie in `[RANGE_LO, RANGE_HI]` (or are zero) keep every product the
+/// axis (`spread`) both lie in `[RANGE_LO, RANGE_HI]` (or are zero) keep the products the
 /// predicates and distance formulas form (up to fourth powers of coordinate differences, and
-/// the tails of Shewchuk's expansions) clear of overflow and underflow. The spread counts
-/// apart from the reach: coordinates in range can differ by far less, as do those of a small
+/// the tails of Shewchuk's expansions) clear of overflow, and of underflow for differences
+/// in the range themselves; far smaller ones along other axes can still underflow (pairs
+/// whose differences span hundreds of orders of magnitude). The spread counts apart
+/// from the reach: coordinates in range can differ by far less, as do those of a small
 /// triangle away from the origin along one axis.
 const RANGE_LO: f64 = 1e-60;
 const RANGE_HI: f64 = 1e60;
@@ -145,34 +147,38 @@ pub(crate) fn pow2(k: i32) -> f64 {
     f64::from_bits(((k.clamp(-1022, 1023) + 1023) as u64) << 52)
 }
 
-/// `floor(log2(x))`: saturates to `i32::MIN` for 0 and `i32::MAX` for infinity.
+/// About `floor(log2(x))` (log2 may round up to the next integer just below a power of two),
+/// clamped to ±1100, past every finite double's: 0 gives -1100 and infinity 1100, so that
+/// sums and negations of a few exponents never overflow.
 pub(crate) fn exponent(x: f64) -> i32 {
-    x.log2().floor() as i32
+    (x.log2().floor() as i32).clamp(-1100, 1100)
 }
 
-/// `v * 2^-e`, in two factors so that each stays representable (`e` can reach -1074).
+/// `v * 2^-e`, in two factors so that each stays representable (`e` from [`exponent`], give
+/// or take a few hundred).
 pub(crate) fn scale_down(v: V, e: i32) -> V {
     v * pow2(-e / 2) * pow2(-e - (-e / 2))
 }
 
-/// `2^e`, which undoes [`scale_down`] on lengths.
-pub(crate) fn scale_up(e: i32) -> f64 {
-    pow2(e / 2) * pow2(e - e / 2)
+/// `x * 2^e`, which undoes [`scale_down`] on a length or coordinate, in two factors too (a
+/// single `2^e` would round to zero or infinity first).
+pub(crate) fn scale_back(x: f64, e: i32) -> f64 {
+    x * pow2(e / 2) * pow2(e - e / 2)
 }
 
-/// Scales both triangles by a power of two `2^-e` that brings their spread to `[1, 4)` (their
-/// reach to just below `2^199` where that would take it further), and returns them with `2^e`
-/// to scale lengths back. Scaling by a power of two is exact (the contact answer is unchanged)
-/// unless it pushes some coordinate below the normal range, which only happens for pairs whose
-/// coordinates span hundreds of orders of magnitude; so does a spread below about `1e-120` of
-/// the reach stay below the range.
+/// Scales both triangles by a power of two `2^-e` that brings their spread to about `[1, 4)`
+/// (their reach to just below `2^199` where that would take it further), and returns them
+/// with `e` to scale lengths back ([`scale_back`]). Scaling by a power of two is exact (the
+/// contact answer is unchanged) unless it pushes some coordinate below the normal range,
+/// which only happens for pairs whose coordinates span hundreds of orders of magnitude; so
+/// does a spread below about `1e-120` of the reach stay below the range.
 #[cold]
-pub(crate) fn rescale(a: &[V; 3], b: &[V; 3], reach: f64, spread: f64) -> ([V; 3], [V; 3], f64) {
+pub(crate) fn rescale(a: &[V; 3], b: &[V; 3], reach: f64, spread: f64) -> ([V; 3], [V; 3], i32) {
     // The spread is at most twice the reach, unless it overflowed to infinity.
     let r = exponent(reach);
     let e = exponent(spread).min(r).max(r - 198);
     let scale = |t: &[V; 3]| t.map(|p| scale_down(p, e));
-    (scale(a), scale(b), scale_up(e))
+    (scale(a), scale(b), e)
 }
 
 /// A point of a coordinate plane: two of the three coordinates of a 3D point, taken exactly.
