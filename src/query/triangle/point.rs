@@ -45,7 +45,7 @@ pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64
     // (the fallback squares those differences): out of the predicates' range these
     // underflow or overflow, and the triangle is solved about `p`, scaled by a power of two
     // (exact) to edges of unit size, or smaller where `p` would then be too far for squares.
-    let reach = t.iter().map(|v| (v - p).amax()).fold(0.0, f64::max);
+    let reach = t.iter().map(|v| (p - v).amax()).fold(0.0, f64::max);
     let extent = (t[1] - t[0]).amax().max((t[2] - t[0]).amax());
     if in_range(reach) && in_range(extent) {
         return closest_in_range(p, t);
@@ -64,6 +64,7 @@ pub fn closest_point_on_triangle(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64
 const MAX_REACH_EXPONENT: i32 = 495;
 
 /// [`closest_point_on_triangle`] for coordinate differences in the predicates' range.
+#[inline(always)]
 fn closest_in_range(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
     by_regions(p, t).unwrap_or_else(|| nearest_of_edges_and_face(p, t))
 }
@@ -71,6 +72,9 @@ fn closest_in_range(p: &Vector3<f64>, t: &Triangle) -> (Vector3<f64>, Feature) {
 /// Ericson's region tests, or `None` where they cannot be trusted (unless a corner's test
 /// answers first): their products cancel to within `1 / ILL_CONDITIONED` of their size (a
 /// sliver, or a triangle of no area, where both are zero).
+// Inlined (with `closest_in_range`) so that the scale check's differences, `p - v` and the
+// edges, are computed once.
+#[inline(always)]
 fn by_regions(p: &Vector3<f64>, t: &Triangle) -> Option<(Vector3<f64>, Feature)> {
     let [a, b, c] = t;
     let (ab, ac, ap) = (b - a, c - a, p - a);
