@@ -233,9 +233,10 @@ mod tests {
 
     #[test]
     fn a_point_over_a_flat_sliver_is_over_its_face_in_every_corner_order() {
-        // Slivers whose region tests cancel: the plane is taken from the longest edge. From
-        // a shorter one the apex's foot falls far along it, rounded by about as much as the
-        // height, and the point was found outside.
+        // Slivers whose region tests cancel, off the origin, in every corner order: the face
+        // is found from an edge's frame, whose apex foot is rounded along the edge by about
+        // as much as the height (before the frame was orthogonalised twice, a shorter edge's
+        // frame found the point outside).
         for (apex, height) in [(0.3, 1e-9), (0.8, 1e-9), (0.8, 1e-12)] {
             let [a, b, c] = [[2.0, 0.0, 0.0], [3.0, 0.0, 0.0], [2.0 + apex, height, 0.0]];
             let p = Vector3::new(2.05 + 0.9 * apex, height / 3.0, 1.0);
