@@ -393,9 +393,19 @@ mod tests {
     /// filter must hand every case it cannot certify to the exact routine.
     #[test]
     fn orient3d_is_exact_where_one_term_is_left_and_cancels() {
+        // At a scale of 2^-10 too (exact, so the same cases): there the products are
+        // below 1, and a bound that multiplied them where it should add would shrink.
+        for scale in [1.0, pow2(-10)] {
+            one_term_left_and_cancelling(scale);
+        }
+    }
+
+    /// [`orient3d_is_exact_where_one_term_is_left_and_cancels`] at coordinates up to 200
+    /// times `scale`.
+    fn one_term_left_and_cancelling(scale: f64) {
         let mut rng = crate::generate::Rng::new(12);
         let mut unit = || rng.unit();
-        let coordinate = |u: f64| 400.0 * u - 200.0;
+        let coordinate = |u: f64| (400.0 * u - 200.0) * scale;
         let mut decided_by_rounding = [0; 3];
         for _ in 0..20_000 {
             let base = V::new(coordinate(unit()), coordinate(unit()), coordinate(unit()));
