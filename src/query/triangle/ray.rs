@@ -211,6 +211,40 @@ mod tests {
     }
 
     #[test]
+    fn a_tie_goes_to_the_triangle_the_nudged_ray_meets() {
+        // Which triangle keeps a shared edge is the side the ray's point falls on when it
+        // is nudged by (−η, −η²) in the sheared frame. Along +z that frame is the world's
+        // x and y; along −z they are swapped (to stay right-handed), so the nudge is −η in
+        // y there.
+        let hit = |tris: &[Triangle], at: Vector3<f64>, dir: Vector3<f64>| {
+            let ray = RaySpace::new(&(at - dir * 3.0), &dir).unwrap();
+            let hits: Vec<usize> = (0..tris.len())
+                .filter(|&i| ray.intersect(&tris[i], f64::INFINITY).is_some())
+                .collect();
+            assert_eq!(hits.len(), 1, "{at:?} along {dir:?}: {hits:?}");
+            hits[0]
+        };
+        let (up, down) = (v(0.0, 0.0, 1.0), v(0.0, 0.0, -1.0));
+        // The unit square's diagonal: below it x > y, above it y > x.
+        let (o, x, xy, y) = (
+            v(0.0, 0.0, 0.0),
+            v(1.0, 0.0, 0.0),
+            v(1.0, 1.0, 0.0),
+            v(0.0, 1.0, 0.0),
+        );
+        let square = [[o, x, xy], [o, xy, y]];
+        assert_eq!(hit(&square, v(0.5, 0.5, 0.0), up), 1, "x − η: above");
+        assert_eq!(hit(&square, v(0.5, 0.5, 0.0), down), 0, "y − η: below");
+        // A horizontal edge along +z: the −η² in y takes the triangle below it.
+        let (l, r) = (v(0.0, 0.5, 0.0), v(1.0, 0.5, 0.0));
+        let split = [[o, r, l], [l, r, v(0.5, 1.0, 0.0)]];
+        assert_eq!(hit(&split, v(0.5, 0.5, 0.0), up), 0, "y − η²: below");
+        // Along −z the same edge is vertical in the sheared frame, whose −η is world y's:
+        // the lower one again.
+        assert_eq!(hit(&split, v(0.5, 0.5, 0.0), down), 0);
+    }
+
+    #[test]
     fn refuses_zero_and_non_finite_directions() {
         assert!(RaySpace::new(&v(0.0, 0.0, 0.0), &v(0.0, 0.0, 0.0)).is_none());
         assert!(RaySpace::new(&v(0.0, 0.0, 0.0), &v(f64::NAN, 0.0, 1.0)).is_none());
