@@ -137,8 +137,8 @@ fn mutants_exclusions_named_by_line_still_find_their_code() {
 }
 
 /// A place an exclusion names: the end of a file's path, a line, the column if one is
-/// given, and the text the mutant changes there (the operator replaced or the field
-/// deleted; `None` if the exclusion names no mutant this reads), regex escapes removed.
+/// given, and the text the mutant changes there (the operator replaced, the field or
+/// unary operator deleted; `None` if the exclusion names no mutant this reads), regex escapes removed.
 struct Site {
     path: String,
     line: usize,
@@ -154,10 +154,14 @@ fn named_site(re: &str) -> Option<Site> {
     let line = line.parse().ok()?;
     let text = match mutant.strip_prefix("replace ") {
         Some(rest) => rest.split_once(" with ").map(|(from, _)| from),
-        None => mutant
-            .strip_prefix("delete field ")
-            .and_then(|rest| rest.split_once(' '))
-            .map(|(field, _)| field),
+        // A field deleted, or a unary operator (`delete - in f`).
+        None => mutant.strip_prefix("delete ").and_then(|rest| {
+            match rest.strip_prefix("field ") {
+                Some(field) => field.split_once(' '),
+                None => rest.split_once(" in "),
+            }
+            .map(|(deleted, _)| deleted)
+        }),
     };
     let unescape = |s: &str| s.replace('\\', "");
     Some(Site {
