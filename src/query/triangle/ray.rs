@@ -5,8 +5,8 @@
 //! meets the triangle where the three 2D edge functions at the origin agree in sign. A
 //! corner's sheared coordinates depend only on the corner and the ray, so two triangles
 //! sharing an edge see it identically; the edge functions' signs are then taken exactly
-//! (Shewchuk's orient2d when the float value is too small to trust), so no ray slips
-//! between them. A ray exactly on an edge or a corner belongs to one triangle only, by a
+//! (the float value unless it is zero, then Shewchuk's orient2d), so no ray slips between
+//! them. A ray exactly on an edge or a corner belongs to one triangle only, by a
 //! tie rule that is a symbolic perturbation of the ray (see [`owns`]).
 
 use super::predicates::orient2d;
@@ -119,22 +119,30 @@ impl RaySpace {
     }
 }
 
-/// `p.x q.y − p.y q.x` for sheared corners, with its sign exact: the float value when
-/// its rounding cannot change the sign, else Shewchuk's adaptive orient2d.
+/// `p.x q.y − p.y q.x` for sheared corners, with its sign exact: the float value when it
+/// is not zero, else Shewchuk's adaptive orient2d.
+///
+/// Rounding to nearest is monotone, so `p.x q.y > p.y q.x` gives rounded products in the
+/// same order (or equal), and their rounded difference the exact sign or zero: a difference
+/// of two products of inputs needs no error bound, only a zero needs the exact routine
+/// (products that underflow to it included). Products that overflow give an infinity of
+/// the right sign or NaN, and [`RaySpace::intersect`] a miss.
 #[inline(always)]
 fn cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
-    let (l, r) = (p[0] * q[1], p[1] * q[0]);
-    let value = l - r;
-    // Shewchuk's first error bound for orient2d, (3 + 16ε)ε of the terms' magnitudes.
-    const BOUND: f64 = (3.0 + 16.0 * f64::EPSILON) * f64::EPSILON / 2.0;
-    // (Products near underflow lose their relative error bound: exact then too.)
-    let terms = l.abs() + r.abs();
-    if value.abs() > BOUND * terms && terms > 1e-280 {
+    let value = p[0] * q[1] - p[1] * q[0];
+    if value != 0.0 {
         value
     } else {
-        // orient2d(0, p, q) is p × q.
-        orient2d([0.0, 0.0], [p[0], p[1]], [q[0], q[1]])
+        exact_cross(p, q)
     }
+}
+
+/// [`cross`] by the exact routine, out of the ray test's hot path.
+#[cold]
+#[inline(never)]
+fn exact_cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+    // orient2d(p, q, 0) is p × q.
+    orient2d([p[0], p[1]], [q[0], q[1]], [0.0, 0.0])
 }
 
 /// Whether the directed edge `p → q` (with its triangle on its left) owns the points of
@@ -242,6 +250,37 @@ mod tests {
         // Along −z the same edge is vertical in the sheared frame, whose −η is world y's:
         // the lower one again.
         assert_eq!(hit(&split, v(0.5, 0.5, 0.0), down), 0);
+    }
+
+    #[test]
+    fn a_float_edge_function_is_zero_or_of_the_exact_sign() {
+        // Nearly parallel p and q: p × q is a difference of two close products, each
+        // rounded. The float value is then often zero, never of the wrong sign, and the
+        // exact routine decides the zeros.
+        let mut rng = crate::generate::Rng::new(31);
+        let mut zeros = 0;
+        for _ in 0..100_000 {
+            let p = [rng.signed(), rng.signed(), 0.0];
+            let s = rng.signed() * 4.0;
+            let q = [
+                p[0] * s + rng.signed() * 1e-16,
+                p[1] * s + rng.signed() * 1e-16,
+                0.0,
+            ];
+            let exact = orient2d([0.0, 0.0], [p[0], p[1]], [q[0], q[1]]);
+            let float = p[0] * q[1] - p[1] * q[0];
+            if float == 0.0 {
+                zeros += 1;
+            } else {
+                assert_eq!(float.signum(), exact.signum(), "{p:?} {q:?}");
+            }
+            assert_eq!(
+                cross(&p, &q).partial_cmp(&0.0),
+                exact.partial_cmp(&0.0),
+                "{p:?} {q:?}"
+            );
+        }
+        assert!(zeros > 10_000, "only {zeros} zeros");
     }
 
     #[test]
