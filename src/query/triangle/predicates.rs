@@ -348,8 +348,9 @@ mod tests {
     }
 
     /// Each term of the filter's error bound counts: a point straight above a corner of a
-    /// nearly vertical triangle (coordinates in the hundreds) leaves only the z term, and
-    /// the z component of the normal cancels nearly to nothing, its sign decided by the
+    /// nearly vertical triangle (coordinates in the hundreds) leaves only the z term (then,
+    /// the axes turned, x's or y's), and that component of the normal cancels nearly to
+    /// nothing, its sign decided by the
     /// products' rounding. The filter must hand every such case it cannot certify to the
     /// exact routine.
     #[test]
@@ -370,12 +371,18 @@ mod tests {
             ];
             let x = V::new(t0.x, t0.y, t0.z + coordinate(unit()));
             let exact = -orient3d_adaptive(&t[0], &t[1], &t[2], &x);
-            let side = PlaneSide::new(&t).side(&t, &x);
-            assert_eq!(
-                side.partial_cmp(&0.0),
-                exact.partial_cmp(&0.0),
-                "{t:?} {x:?}"
-            );
+            // The coordinates turned cyclically (the same sign), so that the term left is
+            // x's, then y's, then z's.
+            for k in 0..3 {
+                let turn = |v: &V| V::new(v[(k + 2) % 3], v[k % 3], v[(k + 1) % 3]);
+                let (t, x) = (t.map(|v| turn(&v)), turn(&x));
+                let side = PlaneSide::new(&t).side(&t, &x);
+                assert_eq!(
+                    side.partial_cmp(&0.0),
+                    exact.partial_cmp(&0.0),
+                    "{t:?} {x:?}"
+                );
+            }
             let d = x - t[0];
             let n = t[1] - t[0];
             let m = t[2] - t[0];
