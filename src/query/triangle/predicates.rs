@@ -372,7 +372,7 @@ mod tests {
             let x = V::new(t0.x, t0.y, t0.z + coordinate(unit()));
             let exact = -orient3d_adaptive(&t[0], &t[1], &t[2], &x);
             // The coordinates turned cyclically (the same sign), so that the term left is
-            // x's, then y's, then z's.
+            // x's, then z's (not turned), then y's.
             for k in 0..3 {
                 let turn = |v: &V| V::new(v[(k + 2) % 3], v[k % 3], v[(k + 1) % 3]);
                 let (t, x) = (t.map(|v| turn(&v)), turn(&x));

@@ -120,29 +120,32 @@ impl RaySpace {
 }
 
 /// `p.x q.y − p.y q.x` for sheared corners, with its sign exact: the float value when it
-/// is not zero, else Shewchuk's adaptive orient2d.
+/// is finite and not zero, else Shewchuk's adaptive orient2d.
 ///
 /// Rounding to nearest is monotone, so `p.x q.y > p.y q.x` gives rounded products in the
 /// same order (or equal), and their rounded difference the exact sign or zero: a difference
-/// of two products of inputs needs no error bound, only a zero needs the exact routine
-/// (products that underflow to it included). Products that overflow give an infinity of
-/// the right sign or NaN, and [`RaySpace::intersect`] a miss.
+/// of two products of inputs needs no error bound, only a zero needs the exact routine.
+/// (That routine, as every floating-point predicate, is exact only where its products do
+/// not underflow: corners below about 1e-150 in the sheared frame.)
 #[inline(always)]
 fn cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
     let value = p[0] * q[1] - p[1] * q[0];
-    if value != 0.0 {
+    // Finite and not zero in one comparison: the magnitude's bits less one stay below
+    // infinity's less one only for those (zero wraps round, NaN's bits lie above).
+    if value.abs().to_bits().wrapping_sub(1) < f64::INFINITY.to_bits() - 1 {
         value
     } else {
         exact_cross(p, q)
     }
 }
 
-/// [`cross`] by the exact routine, out of the ray test's hot path.
+/// [`cross`] by the exact routine, out of the ray test's hot path. As `orient2d(0, p, q)`,
+/// which works on `p − q`: corners so far out that the products overflow (above about
+/// 1e154) often still give a finite value there.
 #[cold]
 #[inline(never)]
 fn exact_cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
-    // orient2d(p, q, 0) is p × q.
-    orient2d([p[0], p[1]], [q[0], q[1]], [0.0, 0.0])
+    orient2d([0.0, 0.0], [p[0], p[1]], [q[0], q[1]])
 }
 
 /// Whether the directed edge `p → q` (with its triangle on its left) owns the points of
@@ -281,6 +284,31 @@ mod tests {
             );
         }
         assert!(zeros > 10_000, "only {zeros} zeros");
+    }
+
+    #[test]
+    fn corners_whose_products_overflow_are_still_hit() {
+        // Corners near 1e158 in the ray's frame: the edge function of b and c overflows
+        // as a difference of products (infinity minus infinity), not as the exact routine
+        // forms it; the ray passes well inside (the other two functions are about 1e145).
+        let tri = [
+            v(-1.0, -1.0 + 1e-13, 0.0),
+            v(1e158, 1e158, 0.0),
+            v(1e158 + 1e145, 1e158 - 1e145, 0.0),
+        ];
+        let ray = RaySpace::new(&v(0.0, 0.0, -1.0), &v(0.0, 0.0, 1.0)).unwrap();
+        let float = |t: &Triangle| {
+            let [_, b, c] = t.map(|p| ray.sheared(&p));
+            c[0] * b[1] - c[1] * b[0]
+        };
+        assert!(float(&tri).is_nan());
+        assert_eq!(ray.intersect(&tri, f64::INFINITY).expect("a hit").t, 1.0);
+        // One product just above the largest double, the other just below: the float
+        // value is infinite, with the right sign, and the exact one about 3.6e305.
+        let x = f64::MAX.sqrt();
+        let tri = [tri[0], v(x, x, 0.0), v(x * 1.001, x * 0.999, 0.0)];
+        assert_eq!(float(&tri), f64::INFINITY);
+        assert_eq!(ray.intersect(&tri, f64::INFINITY).expect("a hit").t, 1.0);
     }
 
     #[test]
