@@ -138,7 +138,8 @@ fn mutants_exclusions_named_by_line_still_find_their_code() {
 
 /// A place an exclusion names: the end of a file's path, a line, the column if one is
 /// given, and the text the mutant changes there (the operator replaced, the field or
-/// unary operator deleted; `None` if the exclusion names no mutant this reads), regex escapes removed.
+/// unary operator deleted; `None` if the exclusion names no mutant this reads), regex
+/// escapes removed.
 struct Site {
     path: String,
     line: usize,

@@ -350,9 +350,8 @@ mod tests {
     /// Each term of the filter's error bound counts: a point straight above a corner of a
     /// nearly vertical triangle (coordinates in the hundreds) leaves only the z term (then,
     /// the axes turned, x's or y's), and that component of the normal cancels nearly to
-    /// nothing, its sign decided by the
-    /// products' rounding. The filter must hand every such case it cannot certify to the
-    /// exact routine.
+    /// nothing, its sign decided by the products' rounding. The filter must hand every such
+    /// case it cannot certify to the exact routine.
     #[test]
     fn plane_side_is_exact_where_the_normal_cancels() {
         let mut rng = crate::generate::Rng::new(11);

@@ -5,9 +5,9 @@
 //! meets the triangle where the three 2D edge functions at the origin agree in sign. A
 //! corner's sheared coordinates depend only on the corner and the ray, so two triangles
 //! sharing an edge see it identically; the edge functions' signs are then taken exactly
-//! (the float value unless it is zero, then Shewchuk's orient2d), so no ray slips between
-//! them. A ray exactly on an edge or a corner belongs to one triangle only, by a
-//! tie rule that is a symbolic perturbation of the ray (see [`owns`]).
+//! (the float value unless it is zero or not finite, then Shewchuk's orient2d), so no ray
+//! slips between them. A ray exactly on an edge or a corner belongs to one triangle only,
+//! by a tie rule that is a symbolic perturbation of the ray (see [`owns`]).
 
 use super::predicates::orient2d;
 use super::Triangle;
