@@ -36,6 +36,7 @@ mod hausdorff;
 mod index;
 mod order;
 mod pair_query;
+mod quad;
 mod ray;
 mod span;
 pub mod triangle;

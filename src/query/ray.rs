@@ -5,6 +5,7 @@
 use super::engine::corrupt;
 use super::index::ray::Slabs;
 use super::index::{Child, SurfaceIndex, WIDTH};
+use super::triangle::ray::LANES;
 use super::triangle::{RaySpace, Triangle};
 use super::{source_id, QueryError, Side, Work};
 use crate::bv::BoundingVolume;
@@ -385,22 +386,32 @@ fn descend<B: BoundingVolume, C: Collect>(
             }
             continue;
         }
-        let (start, count) = (taken.start as usize, taken.count as usize);
-        for i in start..start + count {
-            let (t, face) = index.triangle(i).ok_or_else(missing)?;
-            let Some(hit) = ray.space.intersect(t, collect.horizon(t_max)) else {
-                work.tri_separated += 1;
-                continue;
-            };
-            work.tri_contact += 1;
-            let hit = RayHit {
-                t: hit.t,
-                triangle: source_id(tree, face, Side::A)?,
-                barycentric: hit.barycentric,
-                normal: (ray.pose.rotation() * unit_normal(t)).into(),
-            };
-            if collect.take(hit) {
-                return Ok(work);
+        let (start, end) = (
+            taken.start as usize,
+            taken.start as usize + taken.count as usize,
+        );
+        // A leaf's triangles are prepared together, `LANES` at a time.
+        for first in (start..end).step_by(LANES) {
+            let lanes = first..end.min(first + LANES);
+            let prepared = ray
+                .space
+                .prepare(index.triangles(lanes.clone()).ok_or_else(missing)?);
+            for (lane, i) in lanes.enumerate() {
+                let Some(hit) = prepared.intersect(lane, collect.horizon(t_max)) else {
+                    work.tri_separated += 1;
+                    continue;
+                };
+                work.tri_contact += 1;
+                let (t, face) = index.triangle(i).ok_or_else(missing)?;
+                let hit = RayHit {
+                    t: hit.t,
+                    triangle: source_id(tree, face, Side::A)?,
+                    barycentric: hit.barycentric,
+                    normal: (ray.pose.rotation() * unit_normal(t)).into(),
+                };
+                if collect.take(hit) {
+                    return Ok(work);
+                }
             }
         }
     }

@@ -17,7 +17,6 @@
 //! the same exact triangle tests as before.
 
 pub(in crate::query) mod point;
-mod quad;
 pub(in crate::query) mod ray;
 
 use super::engine::triangle;
@@ -169,6 +168,12 @@ impl SurfaceIndex {
     #[inline(always)]
     pub(in crate::query) fn node(&self, index: u32) -> Option<&IndexNode> {
         self.nodes.get(index as usize)
+    }
+
+    /// The leaf-order triangles of `range`, if they exist.
+    #[inline(always)]
+    pub(in crate::query) fn triangles(&self, range: std::ops::Range<usize>) -> Option<&[Triangle]> {
+        self.triangles.get(range)
     }
 
     /// Leaf-order triangle `i` and its stored face index.

@@ -1,7 +1,7 @@
 //! Rays through the surface index: which children's boxes a ray enters, nearest first.
 
-use super::quad::Quad;
 use super::{Child, IndexNode, WIDTH};
+use crate::query::quad::Quad;
 
 /// A ray in the model frame, set up for slab tests.
 pub(in crate::query) struct Slabs {

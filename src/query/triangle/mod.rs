@@ -27,7 +27,7 @@ mod intersection;
 mod overlap;
 mod point;
 mod predicates;
-mod ray;
+pub(in crate::query) mod ray;
 
 pub use distance::{triangle_distance, triangle_max_distance};
 pub use intersection::{triangle_intersection, IntersectionKind, TriangleIntersection};

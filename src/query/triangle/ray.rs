@@ -11,6 +11,7 @@
 
 use super::predicates::orient2d;
 use super::Triangle;
+use crate::query::quad::Quad;
 use nalgebra::Vector3;
 
 /// A ray prepared for triangle tests: its origin and the shear that maps its direction to
@@ -58,6 +59,62 @@ impl RaySpace {
         })
     }
 
+    /// Where the ray meets closed triangle `t` with a parameter in `[0, t_max]`, if it
+    /// does. A ray in the triangle's plane, or a triangle whose corners are collinear as
+    /// the ray sees them, is a miss. On an edge shared by two triangles on either side of
+    /// it (as the ray sees them) exactly one of them is hit; at a corner, one of the
+    /// triangles around it.
+    #[inline]
+    pub fn intersect(&self, t: &Triangle, t_max: f64) -> Option<RayTriangleHit> {
+        let corners = crate::arr3::map(*t, |p| self.sheared(&p));
+        let [a, b, c] = &corners;
+        let functions = [
+            edge_function(c, b),
+            edge_function(a, c),
+            edge_function(b, a),
+        ];
+        hit(&corners, functions, t_max)
+    }
+
+    /// Up to [`LANES`] triangles (those past it are not looked at) prepared together, one
+    /// per lane: their sheared corners and float edge functions, each value the one
+    /// [`RaySpace::intersect`] computes, to the bit, and which triangles those values alone
+    /// show the ray misses. Most triangles a ray is tested against are missed, and this
+    /// decides them with one branch for the leaf instead of one each.
+    #[inline(always)]
+    // why: corners count to 3 and the axes are a permutation of 0..3, made in `new`.
+    #[allow(clippy::indexing_slicing)]
+    pub(in crate::query) fn prepare(&self, triangles: &[Triangle]) -> Prepared {
+        let [kx, ky, kz] = self.axes;
+        // Lanes past the last triangle repeat the first; nothing asks for them.
+        let lane = |i: usize| triangles.get(i).or(triangles.first());
+        let sheared = |k: usize| {
+            let d = |axis: usize| {
+                let values = std::array::from_fn(|i| lane(i).map_or(0.0, |t| t[k][axis]));
+                Quad::from_array(values) - Quad::splat(self.origin[axis])
+            };
+            let (dx, dy, dz) = (d(kx), d(ky), d(kz));
+            [
+                dx - Quad::splat(self.shear[0]) * dz,
+                dy - Quad::splat(self.shear[1]) * dz,
+                Quad::splat(self.shear[2]) * dz,
+            ]
+        };
+        let [a, b, c] = [sheared(0), sheared(1), sheared(2)];
+        let function = |p: &[Quad; 3], q: &[Quad; 3]| p[0] * q[1] - p[1] * q[0];
+        let functions = [function(&c, &b), function(&a, &c), function(&b, &a)];
+        // A finite non-zero value's sign is exact (see `edge_function`): one of each sign
+        // is a miss whatever the third is.
+        let [u, v, w] = functions.map(Quad::finite_or_zero);
+        let zero = Quad::splat(0.0);
+        let missed = u.min(v).min(w).lt_mask(zero) & zero.lt_mask(u.max(v).max(w));
+        Prepared {
+            corners: [a, b, c].map(|corner| corner.map(Quad::to_array)),
+            functions: functions.map(Quad::to_array),
+            missed,
+        }
+    }
+
     /// A corner in the ray's sheared frame: the ray is the +z axis, and `z` is the ray
     /// parameter of the corner's projection onto it.
     #[inline(always)]
@@ -72,55 +129,92 @@ impl RaySpace {
             self.shear[2] * d[kz],
         ]
     }
+}
 
-    /// Where the ray meets closed triangle `t` with a parameter in `[0, t_max]`, if it
-    /// does. A ray in the triangle's plane, or a triangle whose corners are collinear as
-    /// the ray sees them, is a miss. On an edge shared by two triangles on either side of
-    /// it (as the ray sees them) exactly one of them is hit; at a corner, one of the
-    /// triangles around it.
-    #[inline]
-    pub fn intersect(&self, t: &Triangle, t_max: f64) -> Option<RayTriangleHit> {
-        let [a, b, c] = crate::arr3::map(*t, |p| self.sheared(&p));
-        // Each function is twice the signed area the origin makes with an edge, so the one
-        // of the edge opposite a corner is that corner's weight.
-        let u = cross(&c, &b);
-        let v = cross(&a, &c);
-        let w = cross(&b, &a);
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+/// How many triangles [`RaySpace::prepare`] takes together.
+pub(in crate::query) const LANES: usize = 4;
+
+/// Triangles prepared for one ray by [`RaySpace::prepare`].
+pub(in crate::query) struct Prepared {
+    /// Each corner's sheared coordinates, lane by lane.
+    corners: [[[f64; LANES]; 3]; 3],
+    /// The float edge functions `u`, `v`, `w`, lane by lane.
+    functions: [[f64; LANES]; 3],
+    /// A bit per lane, set where the float edge functions show a miss.
+    missed: u32,
+}
+
+impl Prepared {
+    /// [`RaySpace::intersect`] for the triangle of `lane` (`None` for a lane past
+    /// [`LANES`]; a lane past the triangles given answers for the first).
+    #[inline(always)]
+    pub(in crate::query) fn intersect(&self, lane: usize, t_max: f64) -> Option<RayTriangleHit> {
+        if self.missed >> lane & 1 == 1 {
             return None;
         }
-        let det = u + v + w;
-        if det == 0.0 {
-            return None;
-        }
-        // The origin lies on the line of every edge whose function is zero: the triangle
-        // keeps that edge only if it owns it. With `det > 0` the triangle lies to the right
-        // of a→b→c, so each edge is taken reversed to have the triangle on its left.
-        let on_left = |p: &[f64; 3], q: &[f64; 3]| if det < 0.0 { owns(p, q) } else { owns(q, p) };
-        if (u == 0.0 && !on_left(&b, &c))
-            || (v == 0.0 && !on_left(&c, &a))
-            || (w == 0.0 && !on_left(&a, &b))
-        {
-            return None;
-        }
-        // The corners' ray parameters weighted by the barycentric coordinates (in [0, 1]):
-        // weighting by `u`, `v`, `w` first would square the coordinates' magnitude, and
-        // underflow for triangles below about 1e-100 across or overflow above about 1e100.
-        let barycentric = [u / det, v / det, w / det];
-        let t_hit = barycentric[0] * a[2] + barycentric[1] * b[2] + barycentric[2] * c[2];
-        // (Also refuses NaN, from coordinates so large that products overflow.)
-        if !(t_hit >= 0.0 && t_hit <= t_max) {
-            return None;
-        }
-        Some(RayTriangleHit {
-            t: t_hit,
-            barycentric,
-        })
+        let at = |values: &[f64; LANES]| values.get(lane).copied();
+        let corner = |k: &[[f64; LANES]; 3]| Some([at(&k[0])?, at(&k[1])?, at(&k[2])?]);
+        let [a, b, c] = &self.corners;
+        let [u, v, w] = &self.functions;
+        hit(
+            &[corner(a)?, corner(b)?, corner(c)?],
+            [at(u)?, at(v)?, at(w)?],
+            t_max,
+        )
     }
 }
 
-/// `p.x q.y − p.y q.x` for sheared corners, with its sign exact: the float value when it
-/// is finite and not zero, else Shewchuk's adaptive orient2d.
+/// The hit of the triangle with sheared corners `corners` and float edge functions
+/// `functions` (see [`edge_function`]), if there is one up to `t_max`.
+#[inline(always)]
+fn hit(corners: &[[f64; 3]; 3], functions: [f64; 3], t_max: f64) -> Option<RayTriangleHit> {
+    let [a, b, c] = corners;
+    // Each function is twice the signed area the origin makes with an edge, so the one of
+    // the edge opposite a corner is that corner's weight.
+    let [u, v, w] = functions;
+    let (u, v, w) = (
+        exact_sign(u, c, b),
+        exact_sign(v, a, c),
+        exact_sign(w, b, a),
+    );
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return None;
+    }
+    // The origin lies on the line of every edge whose function is zero: the triangle keeps
+    // that edge only if it owns it. With `det > 0` the triangle lies to the right of
+    // a→b→c, so each edge is taken reversed to have the triangle on its left.
+    let on_left = |p: &[f64; 3], q: &[f64; 3]| if det < 0.0 { owns(p, q) } else { owns(q, p) };
+    if (u == 0.0 && !on_left(b, c)) || (v == 0.0 && !on_left(c, a)) || (w == 0.0 && !on_left(a, b))
+    {
+        return None;
+    }
+    // The corners' ray parameters weighted by the barycentric coordinates (in [0, 1]):
+    // weighting by `u`, `v`, `w` first would square the coordinates' magnitude, and
+    // underflow for triangles below about 1e-100 across or overflow above about 1e100.
+    let barycentric = [u / det, v / det, w / det];
+    let t_hit = barycentric[0] * a[2] + barycentric[1] * b[2] + barycentric[2] * c[2];
+    // (Also refuses NaN, from coordinates so large that products overflow.)
+    if !(t_hit >= 0.0 && t_hit <= t_max) {
+        return None;
+    }
+    Some(RayTriangleHit {
+        t: t_hit,
+        barycentric,
+    })
+}
+
+/// `p.x q.y − p.y q.x` for sheared corners, in floating point.
+#[inline(always)]
+fn edge_function(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+    p[0] * q[1] - p[1] * q[0]
+}
+
+/// [`edge_function`]'s `value` with its sign made exact: itself when it is finite and not
+/// zero, else Shewchuk's adaptive orient2d.
 ///
 /// Rounding to nearest is monotone, so `p.x q.y > p.y q.x` gives rounded products in the
 /// same order (or equal), and their rounded difference the exact sign or zero: a difference
@@ -128,8 +222,7 @@ impl RaySpace {
 /// (That routine, as every floating-point predicate, is exact only where its products do
 /// not underflow: corners below about 1e-150 in the sheared frame.)
 #[inline(always)]
-fn cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
-    let value = p[0] * q[1] - p[1] * q[0];
+fn exact_sign(value: f64, p: &[f64; 3], q: &[f64; 3]) -> f64 {
     // Finite and not zero in one comparison: the magnitude's bits less one stay below
     // infinity's less one only for those (zero wraps round, NaN's bits lie above).
     if value.abs().to_bits().wrapping_sub(1) < f64::INFINITY.to_bits() - 1 {
@@ -139,7 +232,7 @@ fn cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
     }
 }
 
-/// [`cross`] by the exact routine, out of the ray test's hot path. As `orient2d(0, p, q)`,
+/// [`edge_function`] by the exact routine, out of the ray test's hot path. As `orient2d(0, p, q)`,
 /// which works on `p − q`: corners so far out that the products overflow (above about
 /// 1e154) often still give a finite value there.
 #[cold]
@@ -164,6 +257,11 @@ fn owns(p: &[f64; 3], q: &[f64; 3]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An edge function with its exact sign, as the ray test takes it.
+    fn cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
+        exact_sign(edge_function(p, q), p, q)
+    }
 
     fn v(x: f64, y: f64, z: f64) -> Vector3<f64> {
         Vector3::new(x, y, z)
@@ -309,6 +407,69 @@ mod tests {
         let tri = [tri[0], v(x, x, 0.0), v(x * 1.001, x * 0.999, 0.0)];
         assert_eq!(float(&tri), f64::INFINITY);
         assert_eq!(ray.intersect(&tri, f64::INFINITY).expect("a hit").t, 1.0);
+    }
+
+    #[test]
+    fn triangles_prepared_together_answer_as_each_alone() {
+        let mut rng = crate::generate::Rng::new(26);
+        // Corners on a small grid (edge functions of zero, ties at edges and corners,
+        // collinear and repeated corners), anywhere, or far enough out that products
+        // overflow.
+        let corner = |rng: &mut crate::generate::Rng, kind: usize| match kind {
+            0 => v(
+                rng.below(5) as f64 - 2.0,
+                rng.below(5) as f64 - 2.0,
+                rng.below(3) as f64 - 1.0,
+            ),
+            1 => v(rng.signed(), rng.signed(), rng.signed()) * 3.0,
+            _ => v(rng.signed(), rng.signed(), rng.signed()) * 1e158,
+        };
+        let (mut hits, mut ties, mut lanes) = (0, 0, 0);
+        for _ in 0..20_000 {
+            let kind = [0, 0, 1, 2][rng.below(4)];
+            let (origin, target) = (corner(&mut rng, kind) * 4.0, corner(&mut rng, kind));
+            let Some(ray) = RaySpace::new(&origin, &(target - origin)) else {
+                continue;
+            };
+            let count = 1 + rng.below(LANES);
+            let tris: Vec<Triangle> = (0..count)
+                .map(|_| [(); 3].map(|()| corner(&mut rng, kind)))
+                .collect();
+            let t_max = [f64::INFINITY, 1.0, 0.5][rng.below(3)];
+            let prepared = ray.prepare(&tris);
+            for (lane, t) in tris.iter().enumerate() {
+                let alone = ray.intersect(t, t_max);
+                let together = prepared.intersect(lane, t_max);
+                // Bit for bit, NaN-free either way.
+                assert_eq!(
+                    alone.map(|h| (h.t.to_bits(), h.barycentric.map(f64::to_bits))),
+                    together.map(|h| (h.t.to_bits(), h.barycentric.map(f64::to_bits))),
+                    "lane {lane} of {tris:?}"
+                );
+                // Every lane that the float functions alone show missed is decided in the
+                // lanes, and no other.
+                let [a, b, c] = t.map(|p| ray.sheared(&p));
+                let signs = [
+                    edge_function(&c, &b),
+                    edge_function(&a, &c),
+                    edge_function(&b, &a),
+                ]
+                .map(|f| if f.is_finite() { f } else { 0.0 });
+                let shown = signs.iter().any(|&f| f < 0.0) && signs.iter().any(|&f| f > 0.0);
+                assert_eq!(
+                    prepared.missed >> lane & 1 == 1,
+                    shown,
+                    "lane {lane} of {tris:?}"
+                );
+                lanes += 1;
+                hits += usize::from(alone.is_some());
+                ties += usize::from(alone.is_some_and(|h| h.barycentric.contains(&0.0)));
+            }
+        }
+        assert!(
+            lanes > 40_000 && hits > 1_500 && ties > 200,
+            "{lanes} lanes, {hits} hits, {ties} on an edge"
+        );
     }
 
     #[test]

@@ -1,7 +1,8 @@
-//! Four f64 lanes, one per child slot of an index node: two SSE2 registers on x86-64
-//! (SSE2 is part of that target's baseline, so no run-time detection is needed), an array
-//! elsewhere. The compiler does not vectorise the slab test's lanes by itself: it mixes
-//! scalar and packed steps and shuffles between them.
+//! Four f64 lanes, one per child slot of an index node or triangle of a leaf: two SSE2
+//! registers on x86-64 (SSE2 is part of that target's baseline, so no run-time detection is
+//! needed), an array elsewhere. The compiler does not vectorise such lanes by itself: it
+//! mixes scalar and packed steps and shuffles between them. Each operation rounds as the
+//! scalar one does, so a lane's value is the scalar computation's to the bit.
 //!
 //! Comparisons follow the SSE instructions' NaN rule, which the slab test relies on:
 //! [`Quad::max`] and [`Quad::min`] return their second operand where either is NaN.
@@ -15,6 +16,11 @@ impl Quad {
     #[inline(always)]
     pub(in crate::query) fn splat(v: f64) -> Quad {
         Quad(lanes::splat(v))
+    }
+    /// The four values, in lane order.
+    #[inline(always)]
+    pub(in crate::query) fn from_array(v: [f64; 4]) -> Quad {
+        Quad(lanes::load(v))
     }
     /// Four f32 values, widened exactly.
     #[inline(always)]
@@ -40,6 +46,16 @@ impl Quad {
     #[inline(always)]
     pub(in crate::query) fn le_mask(self, b: Quad) -> u32 {
         lanes::le_mask(self.0, b.0)
+    }
+    /// Bit `k` set where lane `k` of `self` is less than `b`'s (unset with NaN).
+    #[inline(always)]
+    pub(in crate::query) fn lt_mask(self, b: Quad) -> u32 {
+        lanes::lt_mask(self.0, b.0)
+    }
+    /// Lane by lane, the value where it is finite and 0 where it is infinite or NaN.
+    #[inline(always)]
+    pub(in crate::query) fn finite_or_zero(self) -> Quad {
+        Quad(lanes::finite_or_zero(self.0))
     }
 }
 
@@ -80,6 +96,11 @@ mod lanes {
         (x, x)
     }
     #[inline(always)]
+    pub fn load(v: [f64; 4]) -> V {
+        let [a, b, c, d] = v;
+        unsafe { (_mm_set_pd(b, a), _mm_set_pd(d, c)) }
+    }
+    #[inline(always)]
     pub fn widen(v: &[f32; 4]) -> V {
         // (A read of the 16 bytes the reference covers.)
         let x = unsafe { _mm_loadu_ps(v.as_ptr()) };
@@ -110,6 +131,21 @@ mod lanes {
         bits as u32
     }
     #[inline(always)]
+    pub fn lt_mask(a: V, b: V) -> u32 {
+        let (lo, hi) = both(a, b, |a, b| unsafe { _mm_cmplt_pd(a, b) });
+        let bits = unsafe { _mm_movemask_pd(lo) | (_mm_movemask_pd(hi) << 2) };
+        bits as u32
+    }
+    #[inline(always)]
+    pub fn finite_or_zero(v: V) -> V {
+        // |x| < ∞ is false for infinities and NaN: those lanes' bits are cleared.
+        let keep = |x: __m128d| unsafe {
+            let magnitude = _mm_andnot_pd(_mm_set1_pd(-0.0), x);
+            _mm_and_pd(x, _mm_cmplt_pd(magnitude, _mm_set1_pd(f64::INFINITY)))
+        };
+        (keep(v.0), keep(v.1))
+    }
+    #[inline(always)]
     pub fn sub(a: V, b: V) -> V {
         both(a, b, |a, b| unsafe { _mm_sub_pd(a, b) })
     }
@@ -131,6 +167,10 @@ mod lanes {
     #[inline(always)]
     pub fn splat(v: f64) -> V {
         [v; 4]
+    }
+    #[inline(always)]
+    pub fn load(v: [f64; 4]) -> V {
+        v
     }
     #[inline(always)]
     pub fn widen(v: &[f32; 4]) -> V {
@@ -155,6 +195,18 @@ mod lanes {
             | u32::from(a1 <= b1) << 1
             | u32::from(a2 <= b2) << 2
             | u32::from(a3 <= b3) << 3
+    }
+    #[inline(always)]
+    pub fn lt_mask(a: V, b: V) -> u32 {
+        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a, b);
+        u32::from(a0 < b0)
+            | u32::from(a1 < b1) << 1
+            | u32::from(a2 < b2) << 2
+            | u32::from(a3 < b3) << 3
+    }
+    #[inline(always)]
+    pub fn finite_or_zero(v: V) -> V {
+        v.map(|x| if x.is_finite() { x } else { 0.0 })
     }
     #[inline(always)]
     pub fn sub(a: V, b: V) -> V {
@@ -182,6 +234,14 @@ mod tests {
         assert!(min[3].is_nan());
         assert_eq!(a.le_mask(b), 0b0010);
         assert_eq!(b.le_mask(a), 0b0001);
+        let c = Quad::from_array([1.0, 3.0, 2.0, f64::NAN]);
+        let d = Quad::from_array([1.0, 2.0, 3.0, 0.0]);
+        assert_eq!(
+            (c.lt_mask(d), d.lt_mask(c), c.le_mask(d)),
+            (0b0100, 0b0010, 0b0101)
+        );
+        let odd = Quad::from_array([f64::INFINITY, -0.5, f64::NAN, f64::NEG_INFINITY]);
+        assert_eq!(odd.finite_or_zero().to_array(), [0.0, -0.5, 0.0, 0.0]);
         let sum = (a - Quad::splat(1.0)) * Quad::splat(2.0);
         assert_eq!(sum.to_array()[0], 0.0);
         assert_eq!(sum.to_array()[3], 6.0);
