@@ -103,7 +103,7 @@ impl RaySpace {
         let [a, b, c] = [sheared(0), sheared(1), sheared(2)];
         let function = |p: &[Quad; 3], q: &[Quad; 3]| p[0] * q[1] - p[1] * q[0];
         let functions = [function(&c, &b), function(&a, &c), function(&b, &a)];
-        // A finite non-zero value's sign is exact (see `edge_function`): one of each sign
+        // A finite non-zero value's sign is exact (see `exact_sign`): one of each sign
         // is a miss whatever the third is.
         let [u, v, w] = functions.map(Quad::finite_or_zero);
         let zero = Quad::splat(0.0);
@@ -149,7 +149,7 @@ impl Prepared {
     /// [`LANES`]; a lane past the triangles given answers for the first).
     #[inline(always)]
     pub(in crate::query) fn intersect(&self, lane: usize, t_max: f64) -> Option<RayTriangleHit> {
-        if self.missed >> lane & 1 == 1 {
+        if lane >= LANES || self.missed >> lane & 1 == 1 {
             return None;
         }
         let at = |values: &[f64; LANES]| values.get(lane).copied();
@@ -232,9 +232,9 @@ fn exact_sign(value: f64, p: &[f64; 3], q: &[f64; 3]) -> f64 {
     }
 }
 
-/// [`edge_function`] by the exact routine, out of the ray test's hot path. As `orient2d(0, p, q)`,
-/// which works on `p − q`: corners so far out that the products overflow (above about
-/// 1e154) often still give a finite value there.
+/// [`edge_function`] by the exact routine, out of the ray test's hot path. As
+/// `orient2d(0, p, q)`, which works on `p − q`: corners so far out that the products
+/// overflow (above about 1e154) often still give a finite value there.
 #[cold]
 #[inline(never)]
 fn exact_cross(p: &[f64; 3], q: &[f64; 3]) -> f64 {
@@ -446,6 +446,12 @@ mod tests {
                     together.map(|h| (h.t.to_bits(), h.barycentric.map(f64::to_bits))),
                     "lane {lane} of {tris:?}"
                 );
+                // And a lane marked missed is not looked at again.
+                let marked = Prepared {
+                    missed: 1 << lane,
+                    ..prepared
+                };
+                assert_eq!(marked.intersect(lane, t_max), None);
                 // Every lane that the float functions alone show missed is decided in the
                 // lanes, and no other.
                 let [a, b, c] = t.map(|p| ray.sheared(&p));
@@ -461,6 +467,12 @@ mod tests {
                     shown,
                     "lane {lane} of {tris:?}"
                 );
+                // And a lane marked missed is not looked at again.
+                let marked = Prepared {
+                    missed: 1 << lane,
+                    ..prepared
+                };
+                assert_eq!(marked.intersect(lane, t_max), None);
                 lanes += 1;
                 hits += usize::from(alone.is_some());
                 ties += usize::from(alone.is_some_and(|h| h.barycentric.contains(&0.0)));
