@@ -690,4 +690,14 @@ mod tests {
         // The fallback is for rounding-limited cases only.
         assert!(exits[2] * 1000 <= disjoint, "{exits:?} of {disjoint}");
     }
+
+    #[test]
+    fn max_distance_ties_go_to_the_first_pair() {
+        // The first corner of `a` is 1 from every corner of `b`, the others closer.
+        let a = [V::zeros(), V::new(0.2, 0.2, 0.2), V::new(0.1, 0.1, 0.1)];
+        let b = [V::x(), V::y(), V::z()];
+        let far = triangle_max_distance(&a, &b);
+        assert_eq!(far.distance, 1.0);
+        assert_eq!((far.point_a, far.point_b), (a[0], b[0]));
+    }
 }
