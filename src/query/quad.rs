@@ -124,17 +124,19 @@ mod lanes {
     pub fn min(a: V, b: V) -> V {
         both(a, b, |a, b| unsafe { _mm_min_pd(a, b) })
     }
+    /// Bit `k` set where lane `k` of a comparison's result is all ones.
     #[inline(always)]
-    pub fn le_mask(a: V, b: V) -> u32 {
-        let (lo, hi) = both(a, b, |a, b| unsafe { _mm_cmple_pd(a, b) });
+    fn mask((lo, hi): V) -> u32 {
         let bits = unsafe { _mm_movemask_pd(lo) | (_mm_movemask_pd(hi) << 2) };
         bits as u32
     }
     #[inline(always)]
+    pub fn le_mask(a: V, b: V) -> u32 {
+        mask(both(a, b, |a, b| unsafe { _mm_cmple_pd(a, b) }))
+    }
+    #[inline(always)]
     pub fn lt_mask(a: V, b: V) -> u32 {
-        let (lo, hi) = both(a, b, |a, b| unsafe { _mm_cmplt_pd(a, b) });
-        let bits = unsafe { _mm_movemask_pd(lo) | (_mm_movemask_pd(hi) << 2) };
-        bits as u32
+        mask(both(a, b, |a, b| unsafe { _mm_cmplt_pd(a, b) }))
     }
     #[inline(always)]
     pub fn finite_or_zero(v: V) -> V {
@@ -188,21 +190,22 @@ mod lanes {
     pub fn min(a: V, b: V) -> V {
         zip(a, b, |a, b| if a < b { a } else { b })
     }
+    /// Bit `k` set where `f` holds for lane `k` of `a` and `b`.
+    #[inline(always)]
+    fn mask(a: V, b: V, f: impl Fn(f64, f64) -> bool) -> u32 {
+        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a, b);
+        u32::from(f(a0, b0))
+            | u32::from(f(a1, b1)) << 1
+            | u32::from(f(a2, b2)) << 2
+            | u32::from(f(a3, b3)) << 3
+    }
     #[inline(always)]
     pub fn le_mask(a: V, b: V) -> u32 {
-        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a, b);
-        u32::from(a0 <= b0)
-            | u32::from(a1 <= b1) << 1
-            | u32::from(a2 <= b2) << 2
-            | u32::from(a3 <= b3) << 3
+        mask(a, b, |a, b| a <= b)
     }
     #[inline(always)]
     pub fn lt_mask(a: V, b: V) -> u32 {
-        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a, b);
-        u32::from(a0 < b0)
-            | u32::from(a1 < b1) << 1
-            | u32::from(a2 < b2) << 2
-            | u32::from(a3 < b3) << 3
+        mask(a, b, |a, b| a < b)
     }
     #[inline(always)]
     pub fn finite_or_zero(v: V) -> V {
