@@ -446,12 +446,6 @@ mod tests {
                     together.map(|h| (h.t.to_bits(), h.barycentric.map(f64::to_bits))),
                     "lane {lane} of {tris:?}"
                 );
-                // And a lane marked missed is not looked at again.
-                let marked = Prepared {
-                    missed: 1 << lane,
-                    ..prepared
-                };
-                assert_eq!(marked.intersect(lane, t_max), None);
                 // Every lane that the float functions alone show missed is decided in the
                 // lanes, and no other.
                 let [a, b, c] = t.map(|p| ray.sheared(&p));
