@@ -691,6 +691,41 @@ mod tests {
         assert!(exits[2] * 1000 <= disjoint, "{exits:?} of {disjoint}");
     }
 
+    /// `Best` keeps the closer of two pairs by their separation, wherever they lie: a pair
+    /// far apart on either side of the origin does not win, a closer one does.
+    #[test]
+    fn the_best_pair_is_the_closest_offered() {
+        let (p, q) = (V::new(3.0, 0.0, 0.0), V::new(4.0, 0.0, 0.0));
+        let mut best = Best::new(p, q);
+        best.offer(-V::x(), V::x());
+        assert_eq!((best.d2, best.pa, best.pb), (1.0, p, q));
+        let (p, q) = (V::new(7.0, 1.0, 0.0), V::new(7.0, 1.5, 0.0));
+        best.offer(p, q);
+        assert_eq!((best.d2, best.pa, best.pb), (0.25, p, q));
+    }
+
+    /// `Prepared::closest` (what `contact`'s fallback offers) is the closed triangle's
+    /// closest point: the same as the point query's, for points over the face, beside
+    /// edges and corners, and on segment-like triangles.
+    #[test]
+    fn the_closest_point_is_the_point_querys() {
+        let mut rng = Rng(11);
+        for k in 0..20_000 {
+            let t = if k % 5 == 0 {
+                let t = rng.tri(V::zeros(), 1.0);
+                [t[0], t[1], t[0] * 0.5 + t[1] * 0.5]
+            } else {
+                rng.tri(V::zeros(), 1.0)
+            };
+            let p = V::new(rng.next(), rng.next(), rng.next()) * 2.0;
+            let got = Prepared::new(&t).closest(&p);
+            let (want, _) = crate::query::triangle::closest_point_on_triangle(&p, &t);
+            let (dg, dw) = ((got - p).norm(), (want - p).norm());
+            assert!((dg - dw).abs() <= 1e-12, "{t:?} {p:?}: {got:?} {want:?}");
+            assert!((got - want).norm() <= 1e-6, "{t:?} {p:?}: {got:?} {want:?}");
+        }
+    }
+
     #[test]
     fn max_distance_ties_go_to_the_first_pair() {
         // The first corner of `a` is 1 from every corner of `b`, the others closer.
