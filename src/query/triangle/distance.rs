@@ -605,18 +605,20 @@ fn contact(fa: &Prepared, fb: &Prepared) -> TriangleDistance {
 /// Where edge `i` of `s` meets the plane of `t`, if it does at a single point.
 #[inline]
 fn edge_plane_crossing(s: &Prepared, i: usize, t: &Prepared) -> Option<V> {
-    if t.nn <= 0.0 {
+    // A degenerate triangle has no plane (`nn` is a square: never negative).
+    if t.nn == 0.0 {
         return None;
     }
     let p = s.corner(i);
-    let sp = (p - t.v[0]).dot(&t.n);
+    let sp = (p - t.corner(0)).dot(&t.n);
     let sq = (s.corner((i + 1) % 3) - t.corner(0)).dot(&t.n);
     let crosses = (sp <= 0.0 && sq >= 0.0) || (sp >= 0.0 && sq <= 0.0);
     if !crosses || sp == sq {
         return None;
     }
+    // In [0, 1]: with opposite signs |sp - sq| = |sp| + |sq|, and rounding is monotone.
     let r = sp / (sp - sq);
-    Some(p + s.edge(i) * r.clamp(0.0, 1.0))
+    Some(p + s.edge(i) * r)
 }
 
 #[cfg(test)]
@@ -724,6 +726,49 @@ mod tests {
             assert!((dg - dw).abs() <= 1e-12, "{t:?} {p:?}: {got:?} {want:?}");
             assert!((got - want).norm() <= 1e-6, "{t:?} {p:?}: {got:?} {want:?}");
         }
+    }
+
+    /// `edge_plane_crossing` (what `contact` tries first) gives the point where an edge's
+    /// ends change side of the other triangle's plane, an end on the plane included, and
+    /// nothing for an edge beside or in the plane or for a degenerate triangle. The plane
+    /// is `z = c`, where the sides are exact.
+    #[test]
+    fn an_edge_crosses_a_plane_where_its_ends_change_side() {
+        let mut rng = Rng(13);
+        let level = |rng: &mut Rng| [-0.5, 0.0, 0.25, 0.5][((rng.next() + 1.0) * 2.0) as usize];
+        let (mut crossed, mut at_end) = (0, 0);
+        for k in 0..20_000 {
+            let c = level(&mut rng);
+            let mut t = rng.tri(V::zeros(), 1.0);
+            t.iter_mut().for_each(|p| p.z = c);
+            if k % 10 == 0 {
+                t[2] = t[0] * 0.5 + t[1] * 0.5;
+            }
+            let mut s = rng.tri(V::zeros(), 1.0);
+            s.iter_mut().for_each(|p| {
+                if rng.next() < -0.5 {
+                    p.z = level(&mut rng);
+                }
+            });
+            let (fs, ft) = (Prepared::new(&s), Prepared::new(&t));
+            for i in 0..3 {
+                let (p, q) = (s[i], s[(i + 1) % 3]);
+                let (sp, sq) = (p.z - c, q.z - c);
+                let expected = ft.nn > 0.0 && sp * sq <= 0.0 && sp != sq;
+                let got = edge_plane_crossing(&fs, i, &ft);
+                assert_eq!(got.is_some(), expected, "{s:?} {t:?} edge {i}: {got:?}");
+                if let Some(x) = got {
+                    crossed += 1;
+                    at_end += usize::from(sp == 0.0 || sq == 0.0);
+                    let want = p + (q - p) * (sp / (sp - sq));
+                    assert!(
+                        (x - want).norm() <= 1e-12,
+                        "{s:?} {t:?} edge {i}: {x:?} {want:?}"
+                    );
+                }
+            }
+        }
+        assert!(crossed > 10_000 && at_end > 1_000, "{crossed} {at_end}");
     }
 
     #[test]
