@@ -589,14 +589,12 @@ fn contact(fa: &Prepared, fb: &Prepared) -> TriangleDistance {
         }
     }
     let mut best = separated_full(fa, fb);
-    if best.d2 > 0.0 {
-        for i in 0..3 {
-            if let Some(x) = edge_plane_crossing(fa, i, fb) {
-                best.offer(x, fb.closest(&x));
-            }
-            if let Some(x) = edge_plane_crossing(fb, i, fa) {
-                best.offer(fa.closest(&x), x);
-            }
+    for i in 0..3 {
+        if let Some(x) = edge_plane_crossing(fa, i, fb) {
+            best.offer(x, fb.closest(&x));
+        }
+        if let Some(x) = edge_plane_crossing(fb, i, fa) {
+            best.offer(fa.closest(&x), x);
         }
     }
     done(mid(&best))
