@@ -603,7 +603,8 @@ fn contact(fa: &Prepared, fb: &Prepared) -> TriangleDistance {
 /// Where edge `i` of `s` meets the plane of `t`, if it does at a single point.
 #[inline]
 fn edge_plane_crossing(s: &Prepared, i: usize, t: &Prepared) -> Option<V> {
-    // A degenerate triangle has no plane (`nn` is a square: never negative).
+    // No usable normal: a degenerate triangle, or `|n|²` underflowed (a square: never
+    // negative).
     if t.nn == 0.0 {
         return None;
     }
