@@ -268,28 +268,48 @@ mod tests {
     #[test]
     fn two_halves_of_a_convex_quad_are_convex_and_others_are_not() {
         let v = |x: f64, y: f64, z: f64| V::new(x, y, z);
+        // The answer is a property of the two triangles as point sets: each case is checked
+        // in either winding of either triangle, with the two swapped, and in each of the
+        // three coordinate planes (so projected along each axis, either way round).
+        let check = |t: [V; 3], u: [V; 3], expected: bool| {
+            let turns: [fn(V) -> V; 3] =
+                [|p| p, |p| V::new(p.z, p.x, p.y), |p| V::new(p.y, p.z, p.x)];
+            let reverse = |s: [V; 3]| [s[0], s[2], s[1]];
+            for turn in turns {
+                let (t, u) = (t.map(turn), u.map(turn));
+                for (t, u) in [
+                    (t, u),
+                    (reverse(t), u),
+                    (t, reverse(u)),
+                    (reverse(t), reverse(u)),
+                ] {
+                    assert_eq!(convex_union(&t, &u), expected, "{t:?} {u:?}");
+                    assert_eq!(convex_union(&u, &t), expected, "{u:?} {t:?}");
+                }
+            }
+        };
         let (a, b, c, d) = (v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.));
         // A square cut along either diagonal, in any corner order.
-        assert!(convex_union(&[a, b, c], &[a, c, d]));
-        assert!(convex_union(&[c, a, b], &[d, c, a]));
-        assert!(convex_union(&[a, b, d], &[b, c, d]));
+        check([a, b, c], [a, c, d], true);
+        check([c, a, b], [d, c, a], true);
+        check([a, b, d], [b, c, d], true);
         // A straight angle at a shared corner is still convex.
-        assert!(convex_union(&[a, b, c], &[a, c, v(-1., 0., 0.)]));
+        check([a, b, c], [a, c, v(-1., 0., 0.)], true);
         // Not convex: a dart, reflex at the shared corner a.
-        assert!(!convex_union(&[a, b, c], &[a, c, v(-1., -0.5, 0.)]));
+        check([a, b, c], [a, c, v(-1., -0.5, 0.)], false);
         // Overlapping: both other corners on one side of the shared edge.
-        assert!(!convex_union(&[a, b, c], &[a, c, v(0.9, 0.2, 0.)]));
-        assert!(!convex_union(&[a, b, c], &[a, c, v(3., 1., 0.)]));
-        // Folded by the least step off the plane, sharing a corner only, or degenerate.
-        assert!(!convex_union(&[a, b, c], &[a, c, v(0., 1., 1e-300)]));
-        assert!(!convex_union(
-            &[a, b, c],
-            &[a, v(-1., 0., 0.), v(-1., -1., 0.)]
-        ));
-        assert!(!convex_union(&[a, b, c], &[a, c, v(2., 2., 0.)]));
-        assert!(!convex_union(&[a, a, c], &[a, c, d]));
+        check([a, b, c], [a, c, v(0.9, 0.2, 0.)], false);
+        check([a, b, c], [a, c, v(3., 1., 0.)], false);
+        // Folded by the least step off the plane, sharing a corner only, or degenerate:
+        // the odd corner on the shared edge's line beyond it, or inside it (where the
+        // diagonals would cross).
+        check([a, b, c], [a, c, v(0., 1., 1e-300)], false);
+        check([a, b, c], [a, v(-1., 0., 0.), v(-1., -1., 0.)], false);
+        check([a, b, c], [a, c, v(2., 2., 0.)], false);
+        check([a, b, c], [a, c, v(0.5, 0.5, 0.)], false);
+        check([a, a, c], [a, c, d], false);
         // The same triangle twice overlaps itself: no other corner.
-        assert!(!convex_union(&[a, b, c], &[a, b, c]));
+        check([a, b, c], [a, b, c], false);
     }
 
     #[test]
