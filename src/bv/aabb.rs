@@ -131,3 +131,53 @@ impl<R: Real> BoundingVolume for Aabb<R> {
 
     box_pair_methods!();
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `verify` refuses a stored box with any non-finite number, in either corner, and one
+    /// whose largest coordinate is below its smallest on any axis; a flat box is well formed.
+    #[test]
+    fn validate_names_each_defect() {
+        let aabb = |min: [f64; 3], max: [f64; 3]| Aabb { min, max };
+        let (lo, hi) = ([-1.0, 0.0, 2.0], [1.0, 0.5, 3.0]);
+        assert_eq!(aabb(lo, hi).validate(), Ok(()));
+        assert_eq!(aabb(lo, [1.0, 0.0, 3.0]).validate(), Ok(()));
+        for k in 0..3 {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let (mut min, mut max) = (lo, hi);
+                min[k] = bad;
+                max[k] = bad;
+                assert_eq!(aabb(min, hi).validate(), Err(BvDefect::NotFinite));
+                assert_eq!(aabb(lo, max).validate(), Err(BvDefect::NotFinite));
+            }
+            let mut max = hi;
+            max[k] = lo[k] - 0.25;
+            assert_eq!(aabb(lo, max).validate(), Err(BvDefect::NegativeExtent));
+        }
+    }
+
+    /// A point is inside up to the tolerance on each axis: on each face, and just beyond
+    /// it with a tolerance that reaches it or not.
+    #[test]
+    fn contains_is_the_box_widened_by_the_tolerance() {
+        let b = Aabb::<f64> {
+            min: [-1.0, 0.0, 2.0],
+            max: [1.0, 0.5, 3.0],
+        };
+        let inside = [0.0, 0.25, 2.5];
+        assert!(b.contains(inside, 0.0));
+        for k in 0..3 {
+            for (end, outward) in [(b.min[k], -1.0), (b.max[k], 1.0)] {
+                let mut p = inside;
+                p[k] = end;
+                assert!(b.contains(p, 0.0), "{p:?}");
+                p[k] = end + outward * 0.125;
+                assert!(!b.contains(p, 0.0), "{p:?}");
+                assert!(!b.contains(p, 0.0625), "{p:?}");
+                assert!(b.contains(p, 0.125), "{p:?}");
+            }
+        }
+    }
+}

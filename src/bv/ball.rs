@@ -157,6 +157,24 @@ mod tests {
         line.push([0.0, 0.0, 0.0]);
         let c = minimal_ball_center(line.iter());
         assert!((reach(c, &line) - 2.0).abs() < 1e-9, "{c:?}");
+        // One point is its own centre, also listed many times; two their midpoint.
+        let point = [0.25, -0.5, 0.125];
+        assert_eq!(minimal_ball_center([point].iter()), point);
+        assert_eq!(minimal_ball_center([point; 6].iter()), point);
+        let pair = [point, [0.75, -0.5, 0.125]];
+        assert_eq!(minimal_ball_center(pair.iter()), [0.5, -0.5, 0.125]);
+        // An octahedron's corners about (3, 0, 0), each listed twice: all on the ball.
+        let octahedron: Vec<[f64; 3]> = [0, 1, 2]
+            .into_iter()
+            .flat_map(|k| [1.0, -1.0].map(|s| std::array::from_fn(|j| f64::from(j == k) * s)))
+            .flat_map(|p: [f64; 3]| [p, p])
+            .map(|p| [p[0] + 3.0, p[1], p[2]])
+            .collect();
+        let c = minimal_ball_center(octahedron.iter());
+        assert!(
+            (Vector3::from(c) - Vector3::new(3.0, 0.0, 0.0)).norm() < 1e-12,
+            "{c:?}"
+        );
     }
 
     /// The degeneracy tests compare a measure with the size of the support, so whether a
@@ -204,17 +222,30 @@ mod tests {
     #[test]
     fn random_clouds_get_a_ball_no_other_centre_improves() {
         let mut rng = crate::generate::Rng::new(5);
-        for n in [3, 10, 100, 1000] {
+        // Clouds about the origin, and small ones away from it: the ball owes nothing to
+        // where the points are or how far they reach.
+        for (n, size, offset) in [
+            (3, 1.0, 0.0),
+            (10, 1.0, 0.0),
+            (100, 1.0, 0.0),
+            (1000, 1.0, 0.0),
+            (2, 0.1, 0.3),
+            (10, 0.1, 0.3),
+            (100, 0.01, -0.2),
+        ] {
             let points: Vec<[f64; 3]> = (0..n)
-                .map(|_| [rng.signed() * 3.0, rng.signed(), rng.signed() * 0.2])
+                .map(|_| {
+                    [rng.signed() * 3.0, rng.signed(), rng.signed() * 0.2]
+                        .map(|x| x * size + offset)
+                })
                 .collect();
             let c = minimal_ball_center(points.iter());
             let r = reach(c, &points);
             // Any move of the centre makes the ball larger (checked along many directions).
             for _ in 0..200 {
-                let step = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 1e-3;
+                let step = Vector3::new(rng.signed(), rng.signed(), rng.signed()) * 1e-3 * size;
                 let moved = (Vector3::from(c) + step).into();
-                assert!(reach(moved, &points) >= r - 1e-12, "n = {n}");
+                assert!(reach(moved, &points) >= r - 1e-12 * size, "n = {n}");
             }
         }
     }

@@ -155,11 +155,15 @@ fn named_site(re: &str) -> Option<Site> {
     let line = line.parse().ok()?;
     let text = match mutant.strip_prefix("replace ") {
         Some(rest) => rest.split_once(" with ").map(|(from, _)| from),
-        // A field deleted, or a unary operator (`delete - in f`).
+        // A field deleted, a match arm (`delete match arm PATTERN in f`, found by its
+        // pattern), or a unary operator (`delete - in f`).
         None => mutant.strip_prefix("delete ").and_then(|rest| {
             match rest.strip_prefix("field ") {
                 Some(field) => field.split_once(' '),
-                None => rest.split_once(" in "),
+                None => rest
+                    .strip_prefix("match arm ")
+                    .unwrap_or(rest)
+                    .split_once(" in "),
             }
             .map(|(deleted, _)| deleted)
         }),
