@@ -226,6 +226,47 @@ mod tests {
         );
     }
 
+    /// A point is inside up to the tolerance: on the sphere, and just beyond it with a
+    /// tolerance that reaches it or not.
+    #[test]
+    fn contains_is_the_ball_widened_by_the_tolerance() {
+        let s = Sphere::<f64> {
+            center: [1.0, -2.0, 3.0],
+            radius: 0.5,
+        };
+        assert!(s.contains([1.0, -2.0, 3.0], 0.0));
+        for k in 0..3 {
+            for outward in [-1.0, 1.0] {
+                let mut p = s.center;
+                p[k] += outward * 0.5;
+                assert!(s.contains(p, 0.0), "{p:?}");
+                p[k] += outward * 0.125;
+                assert!(!s.contains(p, 0.0), "{p:?}");
+                assert!(!s.contains(p, 0.0625), "{p:?}");
+                assert!(s.contains(p, 0.125), "{p:?}");
+            }
+        }
+    }
+
+    /// The sphere about the smallest ball's centre holds every point and is no larger than
+    /// the sphere about the fitted box's centre (for a triangle's corners, far smaller).
+    #[test]
+    fn the_minimal_ball_sphere_holds_the_points_and_is_the_smaller() {
+        let positions = [
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [2.0, 0.5, 0.0],
+            [1.0, 0.1, 0.2],
+        ];
+        let vertices = [0, 1, 2, 3];
+        let ball = Sphere::<f64>::enclose_vertices_minimal_ball(&positions, &vertices)
+            .expect("spheres are fitted to the smallest ball");
+        let fitted = Sphere::<f64>::enclose_vertices(&Matrix3::identity(), &positions, &vertices);
+        assert!(positions.iter().all(|&p| ball.contains(p, 0.0)));
+        assert!(ball.radius <= fitted.radius, "{ball:?} {fitted:?}");
+        assert!((ball.radius - 2.0).abs() < 1e-9, "{ball:?}");
+    }
+
     /// The measures a descent rule and the statistics read, by their formulas.
     #[test]
     fn measures_are_the_spheres() {
