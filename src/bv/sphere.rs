@@ -249,7 +249,7 @@ mod tests {
     }
 
     /// The sphere about the smallest ball's centre holds every point and is no larger than
-    /// the sphere about the fitted box's centre (for a triangle's corners, far smaller).
+    /// the sphere about the fitted box's centre; its radius is half the widest pair's distance.
     #[test]
     fn the_minimal_ball_sphere_holds_the_points_and_is_the_smaller() {
         let positions = [
