@@ -267,6 +267,33 @@ mod tests {
         assert!((ball.radius - 2.0).abs() < 1e-9, "{ball:?}");
     }
 
+    /// The radius holds every point exactly, not only as rounded arithmetic measures it:
+    /// segments of integer corners far from the origin, across the direction (1, 1, 1), so
+    /// that their corners have the centre's own L1 norm and the square root alone would
+    /// round half of the radii below the truth.
+    #[test]
+    fn around_holds_every_point_exactly() {
+        let mut rng = Rng::new(17);
+        for _ in 0..200 {
+            let offset = |rng: &mut Rng| (rng.signed() * 1000.0).round();
+            let base = 2f64.powi(30);
+            let c = [0, 1, 2].map(|_| base + offset(&mut rng));
+            let (a, b) = (offset(&mut rng), offset(&mut rng));
+            let u = [a, b, -(a + b)];
+            let points = [arr3::sub(c, arr3::map(u, |x| -x)), arr3::sub(c, u)];
+            let s = Sphere::<f64>::enclose_points(&Matrix3::identity(), points.iter());
+            for p in points {
+                // Integer differences below 2^12: their squares' sum is exact.
+                let d = arr3::sub(p, s.center);
+                let d2 = dot(d, d);
+                // r² = h + l exactly; r² ≥ d2 iff (h − d2) + l ≥ 0, with h − d2 exact.
+                let h = s.radius * s.radius;
+                let l = s.radius.mul_add(s.radius, -h);
+                assert!(h - d2 >= -l, "{p:?} outside {s:?}");
+            }
+        }
+    }
+
     /// The measures a descent rule and the statistics read, by their formulas.
     #[test]
     fn measures_are_the_spheres() {
