@@ -164,12 +164,15 @@ mod tests {
         let pair = [point, [0.75, -0.5, 0.125]];
         assert_eq!(minimal_ball_center(pair.iter()), [0.5, -0.5, 0.125]);
         // An octahedron's corners about (3, 0, 0), each listed twice: all on the ball.
-        let octahedron: Vec<[f64; 3]> = [0, 1, 2]
-            .into_iter()
-            .flat_map(|k| [1.0, -1.0].map(|s| std::array::from_fn(|j| f64::from(j == k) * s)))
-            .flat_map(|p: [f64; 3]| [p, p])
-            .map(|p| [p[0] + 3.0, p[1], p[2]])
-            .collect();
+        let corners = [
+            [4.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 1.0, 0.0],
+            [3.0, -1.0, 0.0],
+            [3.0, 0.0, 1.0],
+            [3.0, 0.0, -1.0],
+        ];
+        let octahedron: Vec<[f64; 3]> = corners.iter().flat_map(|&p| [p, p]).collect();
         let c = minimal_ball_center(octahedron.iter());
         assert!(
             (Vector3::from(c) - Vector3::new(3.0, 0.0, 0.0)).norm() < 1e-12,

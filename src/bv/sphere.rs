@@ -280,7 +280,7 @@ mod tests {
             let c = [0, 1, 2].map(|_| base + offset(&mut rng));
             let (a, b) = (offset(&mut rng), offset(&mut rng));
             let u = [a, b, -(a + b)];
-            let points = [arr3::sub(c, arr3::map(u, |x| -x)), arr3::sub(c, u)];
+            let points = [1.0, -1.0].map(|side| arr3::zip(c, u).map(|(c, u)| c + side * u));
             let s = Sphere::<f64>::enclose_points(&Matrix3::identity(), points.iter());
             for p in points {
                 // Integer differences below 2^12: their squares' sum is exact.
