@@ -26,11 +26,20 @@ pub struct Sphere<R> {
 }
 
 impl<R: Real> Sphere<R> {
-    /// Distance between the centres once `other` is mapped into this sphere's model frame.
+    /// The distance between the centres once `other` is mapped into this sphere's model
+    /// frame, the sum of the radii, and a bound on the rounding error of either and of
+    /// their difference (model units of this sphere).
     #[inline]
-    fn center_distance(&self, other: &Self, b_to_a: &Pose) -> f64 {
-        let cb = b_to_a.apply(&Vector3::from(point_to_f64(&other.center)));
-        (cb - Vector3::from(point_to_f64(&self.center))).norm()
+    fn centres_radii_slack(&self, other: &Self, b_to_a: &Pose) -> (f64, f64, f64) {
+        let (ca, cb) = (point_to_f64(&self.center), point_to_f64(&other.center));
+        let offset = b_to_a.apply(&Vector3::from(cb)) - Vector3::from(ca);
+        let (d, r) = (offset.norm(), self.radius.to_f64() + other.radius.to_f64());
+        // Mapping B's centre and subtracting A's each round a few ulps of the coordinates'
+        // magnitudes (their sum, which far from the origin dwarfs d and r, is at least d);
+        // the norm and the sums a few ulps of d and r.
+        let magnitudes = l1(&ca) + l1(&cb) + b_to_a.translation_vector().abs().sum();
+        let slack = 4.0 * projection_slack(magnitudes + r);
+        (d, r, slack)
     }
 
     /// The sphere of `points` for `frame` (see [`BoundingVolume::enclose`]).
@@ -132,13 +141,9 @@ impl<R: Real> BoundingVolume for Sphere<R> {
 
     #[inline]
     fn overlaps(&self, other: &Self, b_to_a: &Pose, _guard: f64) -> bool {
-        // A few ulps of slack: the mapped centre is rounded, and a sphere test must never
-        // reject a pair that touches.
-        let (d, r) = (
-            self.center_distance(other, b_to_a),
-            self.radius.to_f64() + other.radius.to_f64(),
-        );
-        d - r <= 8.0 * f64::EPSILON * (d + r)
+        // A sphere test must never reject a pair that touches, whatever the rounding.
+        let (d, r, slack) = self.centres_radii_slack(other, b_to_a);
+        d - r <= slack
     }
 
     #[inline]
@@ -154,14 +159,14 @@ impl<R: Real> BoundingVolume for Sphere<R> {
         b_to_a: &Pose,
         _enough: f64,
     ) -> (f64, f64) {
-        let centres = self.center_distance(other, b_to_a);
-        let bound = (centres - self.radius.to_f64() - other.radius.to_f64()).max(0.0);
-        (bound, centres)
+        let (centres, r, slack) = self.centres_radii_slack(other, b_to_a);
+        ((centres - r - slack).max(0.0), centres)
     }
 
     #[inline]
     fn max_distance_upper_bound(&self, other: &Self, b_to_a: &Pose) -> f64 {
-        self.center_distance(other, b_to_a) + self.radius.to_f64() + other.radius.to_f64()
+        let (centres, r, slack) = self.centres_radii_slack(other, b_to_a);
+        centres + r + slack
     }
 
     fn world_aabb(&self, pose: &Pose) -> Aabb<f64> {
@@ -292,6 +297,124 @@ mod tests {
                 assert!(h - d2 >= -l, "{p:?} outside {s:?}");
             }
         }
+    }
+
+    /// Rounding never makes the sphere test reject a pair that touches, nor the distance
+    /// bounds miss it: sphere pairs posed to touch, under random rotations, small and large,
+    /// near the origin and far from it. Where the posed centres lie is measured in
+    /// double-double arithmetic: the pairs it puts within the sum of the radii must
+    /// overlap at a lower bound of 0, and for the others the upper bound must reach twice
+    /// that sum.
+    #[test]
+    fn spheres_posed_to_touch_overlap() {
+        // a + b and a * b as unevaluated sums of two doubles, exactly.
+        let two_sum = |a: f64, b: f64| {
+            let s = a + b;
+            let v = s - a;
+            (s, (a - (s - v)) + (b - v))
+        };
+        let two_prod = |a: f64, b: f64| {
+            let p = a * b;
+            (p, a.mul_add(b, -p))
+        };
+        // A sum of doubles, to about 2⁻¹⁰⁰ of its largest term.
+        let sum = |terms: &[f64]| {
+            terms.iter().fold((0.0, 0.0), |(hi, lo), &t| {
+                let (s, e) = two_sum(hi, t);
+                two_sum(s, lo + e)
+            })
+        };
+        let mut rng = Rng::new(23);
+        let (mut touching, mut apart) = (0, 0);
+        for k in 0..6000 {
+            // Radii of `size`, centres within `size` of points `far` from the origin (where
+            // their coordinates' rounding dwarfs the radii).
+            let (size, far) = [
+                (1e-3, 0.0),
+                (1.0, 0.0),
+                (1e3, 0.0),
+                (1e-3, 1e6),
+                (1.0, 1e6),
+                (1e3, 1e6),
+                (1e-6, 1e-3),
+            ][k % 7];
+            let vector = |rng: &mut Rng, far: f64| {
+                Vector3::new(rng.signed(), rng.signed(), rng.signed()) * size + Vector3::repeat(far)
+            };
+            // Radii whose sum rounds.
+            let (ra, rb) = (size, size * (1.0 + rng.signed() / 3.0));
+            let rotation = rng.uniform_rotation();
+            let u = Vector3::new(rng.signed(), rng.signed(), rng.signed()).normalize();
+            // B's centre placed at the sum of the radii from A's, to rounding: by the
+            // translation, with both centres far or only B's; or by B's centre, both far,
+            // under a translation of the radii's size.
+            let (ca, cb, t) = match k / 7 % 3 {
+                mode @ (0 | 1) => {
+                    let ca = vector(&mut rng, [far, 0.0][mode]);
+                    let cb = vector(&mut rng, far);
+                    (ca, cb, ca + u * (ra + rb) - rotation * cb)
+                }
+                _ => {
+                    let (ca, t) = (vector(&mut rng, far), vector(&mut rng, 0.0));
+                    (ca, rotation.transpose() * (ca + u * (ra + rb) - t), t)
+                }
+            };
+            let a = Sphere::<f64> {
+                center: ca.into(),
+                radius: ra,
+            };
+            let b = Sphere::<f64> {
+                center: cb.into(),
+                radius: rb,
+            };
+            let b_to_a = Pose::new(rotation, t).expect("a rotation");
+            // The posed centres' offset, each coordinate as a double-double, and its
+            // squared length against the radii's sum squared, both exact to far below an ulp.
+            let mut excess = Vec::new();
+            for i in 0..3 {
+                let mut terms = vec![t[i], -ca[i]];
+                for j in 0..3 {
+                    let (p, e) = two_prod(rotation[(i, j)], cb[j]);
+                    terms.extend([p, e]);
+                }
+                let (hi, lo) = sum(&terms);
+                let (p, e) = two_prod(hi, hi);
+                excess.extend([p, e, 2.0 * hi * lo]);
+            }
+            let (r, r_low) = two_sum(ra, rb);
+            let (r2, r2_low) = two_prod(r, r);
+            excess.extend([-r2, -r2_low, -2.0 * r * r_low]);
+            let (excess, _) = sum(&excess);
+            let case = format!("case {k}: {a:?} and {b:?} under {b_to_a:?}");
+            if excess < -1e-25 * size * size {
+                touching += 1;
+                assert!(a.overlaps(&b, &b_to_a, 0.0), "{case}");
+                assert_eq!(a.distance_lower_bound(&b, &b_to_a), 0.0, "{case}");
+            } else if excess > 1e-25 * size * size {
+                apart += 1;
+                let upper = a.max_distance_upper_bound(&b, &b_to_a);
+                assert!(sum(&[upper, -2.0 * r, -2.0 * r_low]).0 >= 0.0, "{case}");
+            }
+        }
+        assert!(touching > 1000 && apart > 1000, "{touching} {apart}");
+        // With nothing to round but the radii: concentric spheres about the origin reach
+        // the radii's sum, and two points there touch.
+        for _ in 0..1000 {
+            let (ra, rb) = (3.0 * rng.signed().abs(), rng.signed().abs() / 7.0);
+            let [a, b] = [ra, rb].map(|radius| Sphere::<f64> {
+                center: [0.0; 3],
+                radius,
+            });
+            let b_to_a = Pose::new(rng.uniform_rotation(), Vector3::zeros()).expect("a rotation");
+            let (r, r_low) = two_sum(ra, rb);
+            let upper = a.max_distance_upper_bound(&b, &b_to_a);
+            assert!(sum(&[upper, -r, -r_low]).0 >= 0.0, "{a:?} {b:?}");
+        }
+        let point = Sphere::<f64> {
+            center: [0.0; 3],
+            radius: 0.0,
+        };
+        assert!(point.overlaps(&point, &Pose::identity(), 0.0));
     }
 
     /// The measures a descent rule and the statistics read, by their formulas.
