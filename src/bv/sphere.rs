@@ -455,7 +455,7 @@ mod tests {
     }
 
     /// The world box holds the points at the radius along each axis from the posed centre,
-    /// near the origin and far from it.
+    /// near the origin and far from it, and is no wider than rounding needs.
     #[test]
     fn world_aabb_holds_the_posed_sphere() {
         let mut rng = Rng::new(11);
@@ -474,6 +474,16 @@ mod tests {
             };
             let world = s.world_aabb(&pose);
             let c = pose.apply(&center);
+            let rounding = 64.0
+                * f64::EPSILON
+                * (c.abs().max() + s.radius + pose.translation_vector().abs().max());
+            for j in 0..3 {
+                let widening = [world.max[j] - c[j], c[j] - world.min[j]].map(|w| w - s.radius);
+                assert!(
+                    widening.iter().all(|w| w.abs() <= rounding),
+                    "case {k}: {world:?} about {c:?}"
+                );
+            }
             for i in 0..3 {
                 let mut along = Vector3::zeros();
                 along[i] = s.radius;
