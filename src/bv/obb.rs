@@ -401,4 +401,29 @@ mod tests {
         assert_eq!(volume, 48.0);
         assert_eq!(area, 88.0);
     }
+
+    /// A distance bound keeps the stored frames (and their tolerance in the slack) for boxes
+    /// within [`FAR`] times the guard's share of each other, whichever is the larger, and
+    /// re-orthonormalises them beyond; an overlap test always keeps them.
+    #[test]
+    fn frames_are_re_orthonormalised_only_for_boxes_far_apart() {
+        let axes = [[1.0f32, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let boxed = |half: f32| Obb::<f32> {
+            axes,
+            center: [0.0; 3],
+            half: [half; 3],
+        };
+        let (large, small) = (boxed(1.0), boxed(0.01));
+        let tol = axis_tolerance(Precision::F32);
+        // Frames re-orthonormalised past |offset|₁ = FAR · SAT_GUARD · Σh / (4 tol): 7,575.
+        for (a, b) in [(large, small), (small, large)] {
+            for (shift, far) in [(1000.0, false), (1e5, true)] {
+                let b_to_a = Pose::translation(shift, 0.0, 0.0);
+                let metric = a.pair_with(&b, &b_to_a, PairSetup::Metric);
+                assert_eq!(metric.frame_error, if far { 0.0 } else { tol }, "{shift}");
+                let fast = a.pair_with(&b, &b_to_a, PairSetup::Fast);
+                assert_eq!(fast.frame_error, tol);
+            }
+        }
+    }
 }

@@ -420,15 +420,16 @@ mod tests {
     /// The measures a descent rule and the statistics read, by their formulas.
     #[test]
     fn measures_are_the_spheres() {
+        // (A radius of 2 would be its own double's sum.)
         let s = Sphere::<f64> {
             center: [1.0, 2.0, 3.0],
-            radius: 2.0,
+            radius: 3.0,
         };
         let pi = std::f64::consts::PI;
-        assert_eq!(s.diameter(), 4.0);
-        assert_eq!(s.thickness(), 4.0);
-        assert!((s.volume() - 32.0 / 3.0 * pi).abs() < 1e-12);
-        assert!((s.surface_area() - 16.0 * pi).abs() < 1e-12);
+        assert_eq!(s.diameter(), 6.0);
+        assert_eq!(s.thickness(), 6.0);
+        assert!((s.volume() - 36.0 * pi).abs() < 1e-12);
+        assert!((s.surface_area() - 36.0 * pi).abs() < 1e-12);
     }
 
     /// The trait's defaults as spheres take them: the re-wrapped test is the plain one (a
