@@ -402,6 +402,40 @@ mod tests {
         assert_eq!(area, 88.0);
     }
 
+    /// A box along f32 axes (orthonormal only within their tolerance) lies inside the box of
+    /// widened half-widths along the axes made orthonormal: every corner, for boxes of
+    /// several sizes and shapes in random frames.
+    #[test]
+    fn widened_half_widths_hold_the_box_along_orthonormal_axes() {
+        let mut rng = crate::generate::Rng::new(29);
+        let tol = axis_tolerance(Precision::F32);
+        for k in 0..500 {
+            let rows = rounded_rows::<f32>(&rng.uniform_rotation());
+            let scale = [1e-3, 1.0, 1e3][k % 3];
+            let half = [0, 1, 2].map(|_| (rng.signed().abs() * scale) as f32);
+            let b = Obb::<f32> {
+                axes: rows,
+                center: [0.0; 3],
+                half,
+            };
+            let (axes, h) = (b.axes_matrix(), Vector3::from(b.half_f64()));
+            let (q, wide) = (orthonormal_rows(&axes), widen(h, tol));
+            for corner in 0..8 {
+                let sign = |i: usize| if corner >> i & 1 == 0 { -1.0 } else { 1.0 };
+                let p = (0..3).fold(Vector3::zeros(), |p, i| {
+                    p + axes.row(i).transpose() * (sign(i) * h[i])
+                });
+                for j in 0..3 {
+                    let along = q.row(j).transpose().dot(&p);
+                    assert!(
+                        along.abs() <= wide[j],
+                        "case {k}: corner {corner} {along} {wide:?}"
+                    );
+                }
+            }
+        }
+    }
+
     /// A distance bound keeps the stored frames (and their tolerance in the slack) for boxes
     /// within [`FAR`] times the guard's share of each other, whichever is the larger, and
     /// re-orthonormalises them beyond; an overlap test always keeps them.
