@@ -436,9 +436,9 @@ mod tests {
         }
     }
 
-    /// A distance bound keeps the stored frames (and their tolerance in the slack) for boxes
-    /// within [`FAR`] times the guard's share of each other, whichever is the larger, and
-    /// re-orthonormalises them beyond; an overlap test always keeps them.
+    /// A distance bound keeps the stored frames (and their tolerance in the slack) while the
+    /// frames' share of the slack stays within [`FAR`] times the guard's, whichever box is
+    /// the larger, and re-orthonormalises them beyond; an overlap test always keeps them.
     #[test]
     fn frames_are_re_orthonormalised_only_for_boxes_far_apart() {
         let axes = [[1.0f32, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
