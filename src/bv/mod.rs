@@ -563,6 +563,23 @@ pub(crate) fn turned_far_pose(rng: &mut crate::generate::Rng, k: usize) -> Pose 
     Pose::new(rng.uniform_rotation(), t).unwrap_or_default()
 }
 
+/// The eight corners of the box `center + Σ ±half[i] · axes.row(i)`: for the tests of
+/// volumes that must hold a whole box.
+#[cfg(test)]
+pub(crate) fn box_corners(
+    center: &Vector3<f64>,
+    axes: &Matrix3<f64>,
+    half: &Vector3<f64>,
+) -> [Vector3<f64>; 8] {
+    std::array::from_fn(|corner| {
+        let sign = |i: usize| if corner >> i & 1 == 1 { 1.0 } else { -1.0 };
+        center
+            + (0..3)
+                .map(|i| axes.row(i).transpose() * half[i] * sign(i))
+                .sum::<Vector3<f64>>()
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -670,13 +687,8 @@ mod tests {
             let center = Vector3::new(rng.signed(), rng.signed(), rng.signed());
             let half = Vector3::new(rng.unit(), rng.unit(), rng.unit());
             let world = posed_box_aabb(&center, &axes, &half, 0.0, &pose);
-            for corner in 0..8 {
-                let sign = |i: usize| if corner >> i & 1 == 1 { 1.0 } else { -1.0 };
-                let local = center
-                    + (0..3)
-                        .map(|i| axes.row(i).transpose() * half[i] * sign(i))
-                        .sum::<Vector3<f64>>();
-                let p = pose.apply(&local);
+            for (corner, local) in box_corners(&center, &axes, &half).iter().enumerate() {
+                let p = pose.apply(local);
                 for i in 0..3 {
                     assert!(
                         world.min[i] <= p[i] && p[i] <= world.max[i],

@@ -392,6 +392,7 @@ impl<R: Real> BoundingVolume for Obb<R> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bv::box_corners;
 
     /// Diameter, volume and surface area of a box of half-widths 1, 2, 3.
     #[test]
@@ -420,13 +421,9 @@ mod tests {
             };
             let (axes, h) = (b.axes_matrix(), Vector3::from(b.half_f64()));
             let (q, wide) = (orthonormal_rows(&axes), widen(h, tol));
-            for corner in 0..8 {
-                let sign = |i: usize| if corner >> i & 1 == 0 { -1.0 } else { 1.0 };
-                let p = (0..3).fold(Vector3::zeros(), |p, i| {
-                    p + axes.row(i).transpose() * (sign(i) * h[i])
-                });
+            for (corner, p) in box_corners(&Vector3::zeros(), &axes, &h).iter().enumerate() {
                 for j in 0..3 {
-                    let along = q.row(j).transpose().dot(&p);
+                    let along = q.row(j).transpose().dot(p);
                     assert!(
                         along.abs() <= wide[j],
                         "case {k}: corner {corner} {along} {wide:?}"
