@@ -1,6 +1,6 @@
 //! Axis-aligned bounding box in the model frame.
 
-use super::pair::{box_pair_methods, BoxPair, PairSetup};
+use super::pair::{box_pair_methods, BoxPair, Guard, PairSetup};
 use super::{all_finite, face_vertices, listed_vertices, BoundingVolume, BvDefect, BvKind};
 use crate::arr3;
 use crate::pose::Pose;
@@ -49,7 +49,7 @@ impl<R: Real> Aabb<R> {
 
     /// The separating-axis test (see [`BoxPair::disjoint`]).
     #[inline(always)]
-    fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+    fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: Guard) -> bool {
         self.pair_with(other, b_to_a, PairSetup::Fast)
             .disjoint(guard)
     }

@@ -1,6 +1,7 @@
 //! The oriented box of the compact layout: 28 bytes instead of [`Obb<f32>`]'s 60, for trees
 //! shipped where size matters more than query time.
 
+use super::pair::Guard;
 use super::{BoundingVolume, BvDefect, BvKind, Layout, Obb};
 use crate::pose::Pose;
 use crate::real::Real;
@@ -182,12 +183,12 @@ impl BoundingVolume for CompactObb {
     }
 
     #[inline]
-    fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+    fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: Guard) -> bool {
         self.decode().overlaps(&other.decode(), b_to_a, guard)
     }
 
     #[inline]
-    fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+    fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: Guard) -> bool {
         self.decode()
             .overlaps_rewrapped(&other.decode(), b_to_a, guard)
     }

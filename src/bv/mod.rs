@@ -341,9 +341,9 @@ pub trait BoundingVolume:
 
     /// Whether this volume (model A's frame) and `other` (model B's frame, mapped into A's by
     /// `b_to_a`, the pose of B's frame in A's: [`Pose::relative`]) may intersect.
-    /// Conservative: `false` only if they are certainly disjoint. `guard` is the
-    /// separating-axis guard of §4.5 ([`pair::SAT_GUARD`]; boxes only).
-    fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool;
+    /// Conservative: `false` only if they are certainly disjoint, given a `guard` that
+    /// covers the models' coordinates ([`pair::Guard::for_models`]).
+    fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: pair::Guard) -> bool;
 
     /// [`BoundingVolume::overlaps`] as the dissertation's experiments tested boxes of
     /// simpler types: `other` re-wrapped in the smallest box aligned with this volume's
@@ -351,7 +351,7 @@ pub trait BoundingVolume:
     /// ([`pair::BoxPair::rewrapped_disjoint`]). Looser (more pairs pass) and cheaper; the
     /// same as `overlaps` for spheres.
     #[inline]
-    fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+    fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: pair::Guard) -> bool {
         self.overlaps(other, b_to_a, guard)
     }
 

@@ -1,6 +1,6 @@
 //! Oriented bounding box (dissertation §3.2).
 
-use super::pair::{box_pair_methods, BoxPair, PairSetup, SAT_GUARD};
+use super::pair::{box_pair_methods, BoxPair, Guard, PairSetup, SAT_GUARD};
 use super::{
     all_finite, face_vertices, l1, listed_vertices, model_axes_frame, projection_slack,
     BoundingVolume, BvDefect, BvKind,
@@ -112,7 +112,7 @@ impl<R: Real> Obb<R> {
     /// The separating-axis test: on the stored values where they are f32
     /// ([`super::pair_f32`]), else in f64 ([`BoxPair::disjoint`]).
     #[inline(always)]
-    fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+    fn disjoint(&self, other: &Self, b_to_a: &Pose, guard: Guard) -> bool {
         if R::PRECISION == Precision::F32 {
             super::pair_f32::disjoint(self, other, b_to_a, guard)
         } else {

@@ -14,6 +14,52 @@ pub const SAT_GUARD: f64 = 1e-6;
 /// (a few roundings of products and sums of `|t|`-sized terms), with a wide margin.
 pub const OFFSET_ROUNDING: f64 = 64.0 * f64::EPSILON;
 
+/// The margins that keep an overlap test conservative under rounding: volumes that may
+/// touch are never reported apart.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Guard {
+    /// Added to every `|R_ij|` of the separating-axis test (§4.5): [`SAT_GUARD`] in
+    /// queries, 0 only to show why it is needed. Boxes only.
+    pub rotation: f64,
+    /// Added to every comparison (model units of A): the rounding of mapping B's points,
+    /// box centres and triangle vertices alike, into A's frame. It grows with the
+    /// coordinates' magnitude, not with the volumes, so it decides for small volumes far
+    /// from their model's origin. Boxes only: sphere tests bound it pair by pair.
+    pub mapping: f64,
+}
+
+impl Guard {
+    /// `rotation` and no mapping slack: right only for volumes whose coordinates are not
+    /// many orders of magnitude larger than the volumes (unit tests near the origin).
+    pub const fn rotation_only(rotation: f64) -> Guard {
+        Guard {
+            rotation,
+            mapping: 0.0,
+        }
+    }
+
+    /// The guard of a query between two models: `rotation`, and the mapping slack for
+    /// points of A within the ball `a` (centre and radius, A's frame) and of B within the
+    /// ball `b` (B's frame), B posed in A's frame by `b_to_a`.
+    pub fn for_models(
+        rotation: f64,
+        a: ([f64; 3], f64),
+        b: ([f64; 3], f64),
+        b_to_a: &Pose,
+    ) -> Guard {
+        // A point's 1-norm within a ball is at most the centre's plus √3 radii.
+        let magnitude = |(c, r): ([f64; 3], f64)| super::l1(&c) + 3f64.sqrt() * r;
+        let translation = b_to_a.translation_vector().abs().sum();
+        // Mapping rounds a few ulps of |p|₁ + |T|₁, and the difference with A's centre
+        // a few of |c_A|₁; once for B's box centre, once for its vertices.
+        let coordinates = magnitude(a) + magnitude(b) + translation;
+        Guard {
+            rotation,
+            mapping: 2.0 * OFFSET_ROUNDING * coordinates,
+        }
+    }
+}
+
 /// Alternating projections after the first pair in [`BoxPair::closest_direction_gap`]:
 /// each costs about 40 flops; more steps tighten the bound a little (a few fewer pairs
 /// per extra step on the benchmark meshes) and cost more than they save.
@@ -112,20 +158,20 @@ impl BoxPair {
             + (4.0 * self.frame_error + OFFSET_ROUNDING) * (t.x.abs() + t.y.abs() + t.z.abs())
     }
 
-    /// Whether the boxes are disjoint, by the 15 separating axes of §4.3, with `guard` added
-    /// to the absolute rotation entries ([`SAT_GUARD`] in queries; 0 only to demonstrate why
-    /// the guard is needed). Conservative: overlapping boxes are never reported disjoint.
+    /// Whether the boxes are disjoint, by the 15 separating axes of §4.3, with the guard's
+    /// rotation term added to the absolute rotation entries. Conservative: overlapping
+    /// boxes are never reported disjoint.
     ///
     /// Every comparison also gets the [`BoxPair::slack`] of frames that are not exactly
-    /// orthonormal (f32 axes) and of rounding.
+    /// orthonormal (f32 axes) and of rounding, and the guard's mapping slack.
     #[inline(always)]
     // why: 3x3 matrix / 3-vector entries indexed by axis numbers in 0..3 (loop counters and
     // their cyclic successors); the hottest test of every query, kept in the book's form.
     #[allow(clippy::indexing_slicing)]
-    pub fn disjoint(&self, guard: f64) -> bool {
+    pub fn disjoint(&self, guard: Guard) -> bool {
         let (m, t, a, b) = (&self.m, &self.t, &self.ha, &self.hb);
-        let abs = m.abs().add_scalar(guard);
-        let slack = self.slack(guard);
+        let abs = m.abs().add_scalar(guard.rotation);
+        let slack = self.slack(guard.rotation) + guard.mapping;
         if self.separated_on_a_faces(&abs, slack) {
             return true;
         }
@@ -159,9 +205,9 @@ impl BoxPair {
     /// [`BoxPair::disjoint`], and it reports fewer disjoint pairs. Conservative, with the
     /// same guard and slack.
     #[inline(always)]
-    pub fn rewrapped_disjoint(&self, guard: f64) -> bool {
-        let abs = self.m.abs().add_scalar(guard);
-        self.separated_on_a_faces(&abs, self.slack(guard))
+    pub fn rewrapped_disjoint(&self, guard: Guard) -> bool {
+        let abs = self.m.abs().add_scalar(guard.rotation);
+        self.separated_on_a_faces(&abs, self.slack(guard.rotation) + guard.mapping)
     }
 
     /// The first three separating axes: A's faces, with `abs` the guarded `|m|`.
@@ -365,12 +411,17 @@ pub(crate) enum PairSetup {
 macro_rules! box_pair_methods {
     () => {
         #[inline]
-        fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+        fn overlaps(&self, other: &Self, b_to_a: &Pose, guard: $crate::bv::pair::Guard) -> bool {
             !self.disjoint(other, b_to_a, guard)
         }
 
         #[inline]
-        fn overlaps_rewrapped(&self, other: &Self, b_to_a: &Pose, guard: f64) -> bool {
+        fn overlaps_rewrapped(
+            &self,
+            other: &Self,
+            b_to_a: &Pose,
+            guard: $crate::bv::pair::Guard,
+        ) -> bool {
             !self
                 .pair_with(other, b_to_a, $crate::bv::pair::PairSetup::Fast)
                 .rewrapped_disjoint(guard)
@@ -441,6 +492,108 @@ pub(crate) use box_pair_methods;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bv::BoundingVolume;
+    use crate::generate::Rng;
+
+    /// Each half of a model pair's mapping slack bounds the error of mapping one point of
+    /// B's ball into A's frame and taking its offset from a point of A's ball, measured in
+    /// double-double arithmetic: under random rotations, for balls near the origin and
+    /// 1e6 from it, and translations of either size.
+    #[test]
+    fn the_mapping_slack_bounds_the_rounding_of_a_mapped_offset() {
+        let two_sum = |a: f64, b: f64| {
+            let s = a + b;
+            let v = s - a;
+            (s, (a - (s - v)) + (b - v))
+        };
+        let mut rng = Rng::new(41);
+        let mut worst = 0.0f64;
+        for k in 0..3000 {
+            let (far_a, far_b, far_t) = [
+                (0.0, 0.0, 1.0),
+                (1e6, 0.0, 1e6),
+                (1e6, 1e6, 1.0),
+                (0.0, 1e6, 1e6),
+            ][k % 4];
+            let point = |rng: &mut Rng, far: f64| {
+                Vector3::new(rng.signed(), rng.signed(), rng.signed()) + Vector3::repeat(far)
+            };
+            let (ca, cb) = (point(&mut rng, far_a), point(&mut rng, far_b));
+            let (ra, rb) = (1.0 + rng.unit(), 1.0 + rng.unit());
+            let b_to_a = Pose::new(rng.uniform_rotation(), point(&mut rng, 0.0) * far_t)
+                .expect("a rotation");
+            let guard = Guard::for_models(SAT_GUARD, (ca.into(), ra), (cb.into(), rb), &b_to_a);
+            assert_eq!(guard.rotation, SAT_GUARD);
+            // Points on the balls' surfaces, where the magnitudes are largest.
+            let direction = |rng: &mut Rng| point(rng, 0.0).normalize();
+            let p = ca + direction(&mut rng) * ra;
+            let q = cb + direction(&mut rng) * rb;
+            let computed = b_to_a.apply(&q) - p;
+            let (rotation, t) = (b_to_a.rotation(), b_to_a.translation_vector());
+            for i in 0..3 {
+                // The exact offset less the computed one, as a sum of doubles, each term
+                // exact: the products' errors by fused multiply-add.
+                let mut terms = vec![t[i], -p[i], -computed[i]];
+                for j in 0..3 {
+                    let product = rotation[(i, j)] * q[j];
+                    terms.extend([product, rotation[(i, j)].mul_add(q[j], -product)]);
+                }
+                let (hi, lo) = terms.iter().fold((0.0, 0.0), |(hi, lo), &t| {
+                    let (s, e) = two_sum(hi, t);
+                    two_sum(s, lo + e)
+                });
+                let error = (hi + lo).abs();
+                assert!(
+                    error <= guard.mapping / 2.0,
+                    "case {k}: error {error:e}, {guard:?}"
+                );
+                worst = worst.max(error / guard.mapping);
+            }
+        }
+        // A bound of the rounding, not a multiple of the coordinates (catches a slack
+        // inflated by orders of magnitude, which would open far more box pairs).
+        assert!(worst > 1e-3, "worst error {worst:e} of the slack");
+    }
+
+    /// The mapping slack widens every comparison of the box tests: boxes side by side
+    /// along each axis of A, a gap `g` apart, overlap with a slack of `g` and are
+    /// disjoint with one of `g / 2`.
+    #[test]
+    fn the_mapping_slack_widens_each_box_comparison() {
+        let gap = 1e-3;
+        for axis in 0..3 {
+            let mut t = Vector3::zeros();
+            t[axis] = 2.0 + gap;
+            let pair = BoxPair {
+                m: Matrix3::identity(),
+                t,
+                ha: Vector3::repeat(1.0),
+                hb: Vector3::repeat(1.0),
+                frame_error: 0.0,
+            };
+            let with = |mapping: f64| Guard {
+                rotation: 0.0,
+                mapping,
+            };
+            assert!(!pair.disjoint(with(gap)), "axis {axis}");
+            assert!(pair.disjoint(with(gap / 2.0)), "axis {axis}");
+            assert!(!pair.rewrapped_disjoint(with(gap)), "axis {axis}");
+            assert!(pair.rewrapped_disjoint(with(gap / 2.0)), "axis {axis}");
+            // The f32 test on the stored values, whose own rounding slack is far below g.
+            let unit = |center: Vector3<f64>| crate::bv::Obb::<f32> {
+                axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                center: center.map(|c| c as f32).into(),
+                half: [1.0; 3],
+            };
+            let (a, b) = (unit(Vector3::zeros()), unit(t));
+            let identity = Pose::identity();
+            assert!(a.overlaps(&b, &identity, with(gap)), "f32, axis {axis}");
+            assert!(
+                !a.overlaps(&b, &identity, with(gap / 2.0)),
+                "f32, axis {axis}"
+            );
+        }
+    }
 
     /// Two sticks along x, B turned by 1e-8 about z (so that `m₀₀` rounds to exactly 1
     /// while `m₁₀` does not vanish) and 1000 above A: the edge axis `a₀ × b₀` has length 0

@@ -28,7 +28,7 @@
 //! `64u·(|t|₁ + Σ half-widths)` more slack, and the direction's gap that slack and 8u of
 //! itself.
 
-use super::pair::{CONVERGED, OFFSET_ROUNDING, SAT_GUARD};
+use super::pair::{Guard, CONVERGED, OFFSET_ROUNDING, SAT_GUARD};
 use super::Obb;
 use crate::pose::Pose;
 use crate::real::Real;
@@ -453,10 +453,10 @@ impl F32Pair {
     /// in [`super::pair::BoxPair::disjoint`]: `true` only where that test also reports
     /// them disjoint, up to the rounding bounds of the module documentation.
     #[inline(always)]
-    fn disjoint(&self, guard: f64) -> bool {
+    fn disjoint(&self, guard: Guard) -> bool {
         let (m, t, ha, hb) = (self.m, self.t, self.ha, self.hb);
-        let slack = F4::splat(up(self.slack(guard)));
-        let g = F4::splat(up(guard + 17.0 * U));
+        let slack = F4::splat(up(self.slack(guard.rotation) + guard.mapping));
+        let g = F4::splat(up(guard.rotation + 17.0 * U));
         let abs_m = [m[0].abs().add(g), m[1].abs().add(g), m[2].abs().add(g)];
         // A's face axes, all three at once: |t_i| > ha_i + Σ_j hb_j |m_ij|.
         let rb = combine(hb, &transpose(abs_m));
@@ -545,7 +545,7 @@ fn half_sum<R: Real>(o: &Obb<R>) -> f64 {
 /// `true` only where that test also reports them disjoint, up to the rounding bounds of
 /// the module documentation. `R` is `f32` (see [`Real::to_f32`], exact there).
 #[inline(always)]
-pub(crate) fn disjoint<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose, guard: f64) -> bool {
+pub(crate) fn disjoint<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose, guard: Guard) -> bool {
     F32Pair::new(a, b, b_to_a).disjoint(guard)
 }
 

@@ -1,5 +1,6 @@
 //! Bounding sphere.
 
+use super::pair::Guard;
 use super::{
     all_finite, face_vertices, l1, listed_vertices, projection_slack, Aabb, BoundingVolume,
     BvDefect, BvKind,
@@ -140,7 +141,7 @@ impl<R: Real> BoundingVolume for Sphere<R> {
     }
 
     #[inline]
-    fn overlaps(&self, other: &Self, b_to_a: &Pose, _guard: f64) -> bool {
+    fn overlaps(&self, other: &Self, b_to_a: &Pose, _guard: Guard) -> bool {
         // A sphere test must never reject a pair that touches, whatever the rounding.
         let (d, r, slack) = self.centres_radii_slack(other, b_to_a);
         d - r <= slack
@@ -388,7 +389,7 @@ mod tests {
             let case = format!("case {k}: {a:?} and {b:?} under {b_to_a:?}");
             if excess < -1e-25 * size * size {
                 touching += 1;
-                assert!(a.overlaps(&b, &b_to_a, 0.0), "{case}");
+                assert!(a.overlaps(&b, &b_to_a, Guard::rotation_only(0.0)), "{case}");
                 assert_eq!(a.distance_lower_bound(&b, &b_to_a), 0.0, "{case}");
             } else if excess > 1e-25 * size * size {
                 apart += 1;
@@ -414,7 +415,7 @@ mod tests {
             center: [0.0; 3],
             radius: 0.0,
         };
-        assert!(point.overlaps(&point, &Pose::identity(), 0.0));
+        assert!(point.overlaps(&point, &Pose::identity(), Guard::rotation_only(0.0)));
     }
 
     /// The measures a descent rule and the statistics read, by their formulas.
@@ -447,9 +448,12 @@ mod tests {
         };
         for (shift, gap) in [(0.0, 0.0), (4.0, 3.5), (-7.0, 4.5)] {
             let b_to_a = Pose::translation(shift, 0.0, 0.0);
-            let plain = unit.overlaps(&other, &b_to_a, 0.0);
+            let plain = unit.overlaps(&other, &b_to_a, Guard::rotation_only(0.0));
             assert_eq!(plain, gap == 0.0, "shift {shift}");
-            assert_eq!(unit.overlaps_rewrapped(&other, &b_to_a, 0.0), plain);
+            assert_eq!(
+                unit.overlaps_rewrapped(&other, &b_to_a, Guard::rotation_only(0.0)),
+                plain
+            );
             let bound = unit.distance_lower_bound(&other, &b_to_a);
             assert!((bound - gap).abs() < 1e-12, "shift {shift}: {bound}");
         }

@@ -3,7 +3,7 @@
 use super::engine::{traverse, triangle, Flow, Policy, QueryContext};
 use super::triangle::{triangle_intersection, triangles_intersect, Triangle, TriangleIntersection};
 use super::{source_id, DescentRule, Pose, QueryError, Side, Work};
-use crate::bv::pair::{OFFSET_ROUNDING, SAT_GUARD};
+use crate::bv::pair::{Guard, OFFSET_ROUNDING, SAT_GUARD};
 use crate::bv::BoundingVolume;
 use crate::tree::TreeView;
 use nalgebra::Vector3;
@@ -98,7 +98,7 @@ impl CollideResult {
 }
 
 struct Collide {
-    guard: f64,
+    guard: Guard,
     rewrapped: bool,
     first: bool,
     faces: Vec<(u32, u32)>,
@@ -183,8 +183,11 @@ pub fn collide_into<B: BoundingVolume>(
     let b_to_a = Pose::relative(pose_a, pose_b);
     result.pairs.clear();
     result.colliding = false;
+    // (Empty trees have no root and nothing to guard.)
+    let mut guard = Guard::rotation_only(options.guard);
     if let (Some(ra), Some(rb)) = (a.node(0), b.node(0)) {
-        if balls_apart(&ra.bv, &rb.bv, &b_to_a) {
+        let (ball_a, ball_b) = (ra.bv.enclosing_ball(), rb.bv.enclosing_ball());
+        if balls_apart(ball_a, ball_b, &b_to_a) {
             // The root pair, tested and found disjoint (the boxes lie in the balls).
             result.work = Work {
                 bv_disjoint: 1,
@@ -193,11 +196,12 @@ pub fn collide_into<B: BoundingVolume>(
             };
             return Ok(());
         }
+        guard = Guard::for_models(options.guard, ball_a, ball_b, &b_to_a);
     }
     let mut faces = std::mem::take(&mut context.faces);
     faces.clear();
     let mut policy = Collide {
-        guard: options.guard,
+        guard,
         rewrapped: options.box_test == BoxTest::Rewrapped,
         first: options.first_contact,
         faces,
@@ -231,14 +235,12 @@ pub fn collide_into<B: BoundingVolume>(
     Ok(())
 }
 
-/// Whether the enclosing balls of two volumes are certainly apart: the first test of a
-/// collision query, since models far apart (most of the pairs a scene asks about) are
-/// culled at their roots, and a ball test costs a tenth of a box test (two 3×3 products
-/// and the separating axes).
+/// Whether the enclosing balls (centre, radius) of two volumes are certainly apart: the
+/// first test of a collision query, since models far apart (most of the pairs a scene asks
+/// about) are culled at their roots, and a ball test costs a tenth of a box test (two 3×3
+/// products and the separating axes).
 #[inline]
-fn balls_apart<B: BoundingVolume>(a: &B, b: &B, b_to_a: &Pose) -> bool {
-    let (ca, ra) = a.enclosing_ball();
-    let (cb, rb) = b.enclosing_ball();
+fn balls_apart((ca, ra): ([f64; 3], f64), (cb, rb): ([f64; 3], f64), b_to_a: &Pose) -> bool {
     let (ca, cb) = (Vector3::from(ca), b_to_a.apply(&Vector3::from(cb)));
     // Mapping B's centre and the difference round by a few ulps of their magnitudes.
     let rounding = OFFSET_ROUNDING * (ca.abs().sum() + cb.abs().sum());

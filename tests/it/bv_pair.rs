@@ -7,7 +7,7 @@ use crate::common;
 
 use common::oracle;
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use obbtree::bv::pair::{BoxPair, OFFSET_ROUNDING, SAT_GUARD};
+use obbtree::bv::pair::{BoxPair, Guard, OFFSET_ROUNDING, SAT_GUARD};
 use obbtree::bv::{Aabb, BoundingVolume, Obb, Sphere};
 use obbtree::query::triangle::Triangle;
 use obbtree::query::Pose;
@@ -170,7 +170,7 @@ proptest! {
         prop_assert!(lb <= sampled + 1e-12, "lower bound {lb} > sampled {sampled}");
         // A positive bound means the boxes are disjoint, which the overlap test must not contradict
         // beyond its guard, and an overlap verdict of "disjoint" needs separation.
-        if !a.overlaps(&b, &b_to_a, SAT_GUARD) {
+        if !a.overlaps(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)) {
             prop_assert!(sampled > 0.0);
         }
     }
@@ -187,7 +187,7 @@ proptest! {
         let d = surface_distance(&a, &b, &b_to_a);
         prop_assert!(lb <= d + 1e-9, "lower bound {lb} above the surface distance {d}");
         // (Below about 1e-4 the guard's slack, 1e-6 of the boxes' size, takes its share.)
-        if d > 1e-3 && !a.overlaps(&b, &b_to_a, 0.0) {
+        if d > 1e-3 && !a.overlaps(&b, &b_to_a, Guard::rotation_only(0.0)) {
             prop_assert!(lb >= 2.0 / 3.0 * d, "lower bound {lb} below 2/3 of the distance {d}");
         }
     }
@@ -208,8 +208,8 @@ proptest! {
         let nested = corners(&b).iter().any(|q| a.contains(b_to_a.apply(q).into(), 0.0))
             || corners(&a).iter().any(|p| b.contains((a_to_b * nalgebra::Point3::from(*p)).coords.into(), 0.0));
         if d > 1e-4 * size && !nested {
-            prop_assert!(!a.overlaps(&b, &b_to_a, SAT_GUARD), "distance {d}, size {size}: reported overlapping");
-            prop_assert!(!a.overlaps(&b, &b_to_a, 0.0), "distance {d}, size {size}: overlapping unguarded");
+            prop_assert!(!a.overlaps(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)), "distance {d}, size {size}: reported overlapping");
+            prop_assert!(!a.overlaps(&b, &b_to_a, Guard::rotation_only(0.0)), "distance {d}, size {size}: overlapping unguarded");
         }
     }
 
@@ -241,9 +241,9 @@ proptest! {
         // B's centre on A's at s = 0, then s along `direction`.
         let pose_at = |s: f64| Pose::new(r, ca - r * cb + direction * s).unwrap();
         let f64_disjoint = |s: f64| {
-            BoxPair::new(&axes_a, &ca, ha, &axes_b, &cb, hb, &pose_at(s), 1e-6).disjoint(SAT_GUARD)
+            BoxPair::new(&axes_a, &ca, ha, &axes_b, &cb, hb, &pose_at(s), 1e-6).disjoint(Guard::rotation_only(SAT_GUARD))
         };
-        let f32_disjoint = |s: f64| !fa.overlaps(&fb, &pose_at(s), SAT_GUARD);
+        let f32_disjoint = |s: f64| !fa.overlaps(&fb, &pose_at(s), Guard::rotation_only(SAT_GUARD));
         let (mut lo, mut hi) = (0.0f64, 10.0f64);
         prop_assume!(!f64_disjoint(lo) && f64_disjoint(hi));
         while hi - lo > f64::EPSILON * hi {
@@ -267,7 +267,7 @@ proptest! {
         let u = f64::from(f32::EPSILON) / 2.0;
         let budget = BoxPair::new(&axes_a, &ca, ha, &axes_b, &cb, hb, &pose_at(lo), 1e-6 + 32.0 * u);
         prop_assert!(
-            !budget.disjoint(SAT_GUARD + 128.0 * u),
+            !budget.disjoint(Guard::rotation_only(SAT_GUARD + 128.0 * u)),
             "f32 test overlaps at offset {lo}, beyond the f64 test given twice its rounding budget"
         );
     }
@@ -302,8 +302,8 @@ proptest! {
         // If some point of B lies inside A, the boxes overlap and the test must say so.
         let inside = grid_points(&b, 5).iter().any(|q| a.contains(b_to_a.apply(q).into(), 1e-12));
         if inside {
-            prop_assert!(a.overlaps(&b, &b_to_a, SAT_GUARD));
-            prop_assert!(a.overlaps(&b, &b_to_a, 0.0));
+            prop_assert!(a.overlaps(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)));
+            prop_assert!(a.overlaps(&b, &b_to_a, Guard::rotation_only(0.0)));
             prop_assert_eq!(a.distance_lower_bound(&b, &b_to_a), 0.0);
         }
     }
@@ -312,12 +312,12 @@ proptest! {
     fn the_rewrapped_test_is_looser_and_still_never_misses_an_overlap(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
         // Every pair the 15 axes pass, the re-wrapped box passes too (it tests 3 of them),
         // and overlapping boxes pass both.
-        if a.overlaps(&b, &b_to_a, SAT_GUARD) {
-            prop_assert!(a.overlaps_rewrapped(&b, &b_to_a, SAT_GUARD));
+        if a.overlaps(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)) {
+            prop_assert!(a.overlaps_rewrapped(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)));
         }
         let inside = grid_points(&b, 5).iter().any(|q| a.contains(b_to_a.apply(q).into(), 1e-12));
         if inside {
-            prop_assert!(a.overlaps_rewrapped(&b, &b_to_a, SAT_GUARD));
+            prop_assert!(a.overlaps_rewrapped(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)));
         }
     }
 
@@ -360,7 +360,7 @@ proptest! {
         let s1 = Sphere { center: c1, radius: r1 };
         let s2 = Sphere { center: c2, radius: r2 };
         let d = (Vector3::from(c1) - b_to_a.apply(&Vector3::from(c2))).norm();
-        prop_assert_eq!(s1.overlaps(&s2, &b_to_a, 0.0), d <= r1 + r2);
+        prop_assert_eq!(s1.overlaps(&s2, &b_to_a, Guard::rotation_only(0.0)), d <= r1 + r2);
         prop_assert!((s1.distance_lower_bound(&s2, &b_to_a) - (d - r1 - r2).max(0.0)).abs() < 1e-12);
         prop_assert!((s1.max_distance_upper_bound(&s2, &b_to_a) - (d + r1 + r2)).abs() < 1e-12);
         let lo1 = [c1[0] - r1, c1[1] - r1, c1[2] - r1];
@@ -371,7 +371,7 @@ proptest! {
         let a2 = Aabb { min: lo2, max: hi2 };
         let o1 = obb(Matrix3::identity(), Vector3::from(c1), Vector3::repeat(r1));
         let o2 = obb(Matrix3::identity(), Vector3::from(c2), Vector3::repeat(r2));
-        prop_assert_eq!(a1.overlaps(&a2, &b_to_a, SAT_GUARD), o1.overlaps(&o2, &b_to_a, SAT_GUARD));
+        prop_assert_eq!(a1.overlaps(&a2, &b_to_a, Guard::rotation_only(SAT_GUARD)), o1.overlaps(&o2, &b_to_a, Guard::rotation_only(SAT_GUARD)));
         prop_assert!((a1.max_distance_upper_bound(&a2, &b_to_a) - o1.max_distance_upper_bound(&o2, &b_to_a)).abs() < 2e-8);
     }
 }
@@ -389,7 +389,7 @@ fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
         Vector3::new(0.5, 0.5, 0.5),
     );
     let b_to_a = Pose::translation(3.0, 0.0, 0.0);
-    assert!(!a.overlaps(&b, &b_to_a, SAT_GUARD));
+    assert!(!a.overlaps(&b, &b_to_a, Guard::rotation_only(SAT_GUARD)));
     // The exact gap, less the guard's slack of 1e-6 x the half-widths (4.5e-6) and the f64
     // frames' 4e-10 x the offset.
     let lb = a.distance_lower_bound(&b, &b_to_a);
@@ -411,7 +411,7 @@ fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
         &b_to_a,
         0.0,
     );
-    assert!(pair.disjoint(0.0));
+    assert!(pair.disjoint(Guard::rotation_only(0.0)));
 }
 
 /// Boxes far apart along a diagonal: the separating-axis gaps alone reach only about 1/√3
@@ -533,8 +533,8 @@ fn box_pair(m: Matrix3<f64>, t: [f64; 3], ha: [f64; 3], hb: [f64; 3], frame_erro
 fn zero_size_boxes_at_one_point_touch() {
     for m in [Matrix3::identity(), rotation(0.3, -1.1, 2.0)] {
         let pair = box_pair(m, [0.0; 3], [0.0; 3], [0.0; 3], 0.0);
-        assert!(!pair.disjoint(0.0), "{m}");
-        assert!(!pair.disjoint(SAT_GUARD), "{m}");
+        assert!(!pair.disjoint(Guard::rotation_only(0.0)), "{m}");
+        assert!(!pair.disjoint(Guard::rotation_only(SAT_GUARD)), "{m}");
         assert_eq!(pair.distance_lower_bound(), 0.0);
         assert_eq!(pair.max_distance(), 0.0);
         // The alternating projections meet: no direction, and no gap along it.
@@ -549,7 +549,7 @@ fn boxes_at_zero_offset_overlap() {
     let h = [1.0, 2.0, 3.0];
     for m in [Matrix3::identity(), rotation(0.3, -1.1, 2.0)] {
         let pair = box_pair(m, [0.0; 3], h, h, 0.0);
-        assert!(!pair.disjoint(0.0));
+        assert!(!pair.disjoint(Guard::rotation_only(0.0)));
         assert_eq!(pair.distance_lower_bound(), 0.0);
         assert_eq!(pair.closest_direction_gap(), (0.0, 0.0));
     }
@@ -572,7 +572,7 @@ fn cubes_side_by_side_have_their_gap_as_lower_bound() {
     let expected = 1.0 - pair.slack(SAT_GUARD);
     assert!((pair.distance_lower_bound() - expected).abs() < 1e-12);
     assert!((pair.distance_lower_bound_until(0.5) - expected).abs() < 1e-12);
-    assert!(pair.disjoint(SAT_GUARD));
+    assert!(pair.disjoint(Guard::rotation_only(SAT_GUARD)));
 }
 
 /// Where cubes of half-width `h` side by side along x (offset `y` across, frames `frame_error`
@@ -601,7 +601,7 @@ fn separation_is_reported_at_the_edge_of_the_slack() {
                 frame_error,
             );
             assert_eq!(
-                pair.disjoint(SAT_GUARD),
+                pair.disjoint(Guard::rotation_only(SAT_GUARD)),
                 apart,
                 "frame error {frame_error}, offset {scale} of the edge"
             );
@@ -626,7 +626,7 @@ fn separation_is_reported_at_the_edge_of_the_slack() {
     for (scale, apart) in [(1.0 - 1e-6, false), (1.0 + 1e-6, true)] {
         let pose = Pose::translation(edge * scale, y, 0.0);
         assert_eq!(
-            !cube.overlaps(&cube, &pose, SAT_GUARD),
+            !cube.overlaps(&cube, &pose, Guard::rotation_only(SAT_GUARD)),
             apart,
             "f32, {scale} of the edge"
         );

@@ -20,7 +20,7 @@ use crate::common;
 use common::oracle;
 use nalgebra::{Matrix3, Vector3};
 use obbtree::build::{build, BuildOptions};
-use obbtree::bv::pair::{BoxPair, SAT_GUARD};
+use obbtree::bv::pair::{BoxPair, Guard, SAT_GUARD};
 use obbtree::bv::BvKind;
 use obbtree::format::ObbtFile;
 use obbtree::mesh::TriMesh;
@@ -216,11 +216,11 @@ fn guard_case_boxes_overlap_and_only_the_guarded_test_says_so() {
         );
     }
     assert!(
-        pair.disjoint(0.0),
+        pair.disjoint(Guard::rotation_only(0.0)),
         "without the guard the near-zero axis a_x × b_x separates the boxes"
     );
     assert!(
-        !pair.disjoint(SAT_GUARD),
+        !pair.disjoint(Guard::rotation_only(SAT_GUARD)),
         "with the 1e-6 guard the boxes are reported overlapping"
     );
     // The guard is needed only because of the noise: with an exactly orthonormal rotation
@@ -229,7 +229,7 @@ fn guard_case_boxes_overlap_and_only_the_guarded_test_says_so() {
         m: Matrix3::identity(),
         ..pair
     };
-    assert!(!exact.disjoint(0.0));
+    assert!(!exact.disjoint(Guard::rotation_only(0.0)));
 }
 
 #[test]
@@ -836,6 +836,87 @@ fn near_contact_under_a_common_rotation_keeps_the_distance_error_bound() {
                     );
                 }
             }
+        }
+    }
+}
+
+/// A small triangle resting flat on another, far from their model's origin (a part laid on
+/// another in an assembly's coordinates): B is posed into A's plane, so whether each of its
+/// corners lies above, on or below it is decided by the rounding of the mapping, and every
+/// pair the brute force finds on the coordinates as the query maps them must be found.
+/// Mapping B's box centres and corners into A's frame rounds by ulps of the coordinates
+/// (1e6 here), far more than the separating-axis guard's share of boxes 1e-5 across; the
+/// guard's mapping slack covers it at any size (f64 files: f32 cannot store triangles this
+/// small this far out).
+#[test]
+fn small_triangles_resting_on_each_other_far_from_the_origin() {
+    const FAR: f64 = 1e6;
+    const SIZE: f64 = 1e-5;
+    // Tilted, so that points of its plane are rarely on the grid of f64 values there.
+    let (p0, p1, p2) = (
+        Vector3::new(FAR, FAR, FAR),
+        Vector3::new(FAR + SIZE, FAR, FAR + 0.3 * SIZE),
+        Vector3::new(FAR, FAR + SIZE, FAR + 0.2 * SIZE),
+    );
+    let a = one_triangle(p0.into(), p1.into(), p2.into());
+    // A's plane as a frame: B's local x, y and z (its normal) onto A's edge, the in-plane
+    // direction across it, and A's normal.
+    let x = (p1 - p0).normalize();
+    let z = x.cross(&(p2 - p0)).normalize();
+    let onto_a = Matrix3::from_columns(&[x, z.cross(&x), z]);
+    let corners = [[0.1, 0.2, 0.0], [0.3, 0.25, 0.0], [0.15, 0.4, 0.0]]
+        .map(|p: [f64; 3]| p.map(|c| c * SIZE / 4.0));
+    let b = one_triangle(corners[0], corners[1], corners[2]);
+    let mut rng = common::rng::Rng::new(20261202);
+    let poses: Vec<Pose> = (0..2000)
+        .map(|_| {
+            let rotation = onto_a * rotation_about([0.0, 0.0, 1.0], 6.3 * rng.unit());
+            // Corner 0 onto a point well inside A's face.
+            let (u, v) = (0.2 + 0.3 * rng.unit(), 0.2 + 0.3 * rng.unit());
+            let target = p0 + (p1 - p0) * u + (p2 - p0) * v;
+            pose(
+                rotation,
+                (target - rotation * Vector3::from(corners[0])).into(),
+            )
+        })
+        .collect();
+    let ta = world_triangles(&a, Precision::F64, &Pose::identity());
+    let b_local = world_triangles(&b, Precision::F64, &Pose::identity());
+    let truths: Vec<_> = poses
+        .iter()
+        .map(|pose_b| {
+            let tb = oracle::in_frame_of_a(&Pose::identity(), pose_b, &b_local);
+            oracle::contact_pairs(&ta, &tb)
+        })
+        .collect();
+    // Both outcomes occur: the case sits on the boundary it is meant to test.
+    let touching = truths.iter().filter(|t| !t.is_empty()).count();
+    assert!(
+        touching > poses.len() / 20 && touching < poses.len() * 19 / 20,
+        "{touching} of {} poses touch",
+        poses.len()
+    );
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
+    for options in common::all_options() {
+        if options.precision != Precision::F64 {
+            continue;
+        }
+        let (fa, fb) = (built(&a, &options), built(&b, &options));
+        let mut pair = PairQuery::new(&fa, &fb).unwrap();
+        for (i, (pose_b, truth)) in poses.iter().zip(&truths).enumerate() {
+            let all = pair
+                .collide(&Pose::identity(), pose_b, &CollideOptions::default())
+                .unwrap();
+            assert_eq!(&all.pairs, truth, "{options:?}, pose {i}: contacting pairs");
+            let one = pair.collide(&Pose::identity(), pose_b, &first).unwrap();
+            assert_eq!(
+                one.colliding,
+                !truth.is_empty(),
+                "{options:?}, pose {i}: first contact"
+            );
         }
     }
 }
