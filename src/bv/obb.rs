@@ -70,7 +70,7 @@ impl<R: Real> Obb<R> {
         // (Overlap tests never re-orthonormalise: the frame term is only worked out for
         // distance bounds.)
         if setup == PairSetup::Metric
-            && 4.0 * tol * offset.abs().sum() > FAR * SAT_GUARD * (ha.sum() + hb.sum())
+            && frames_far_apart(tol, offset.abs().sum(), ha.sum() + hb.sum())
         {
             return BoxPair::from_offset(
                 &orthonormal_rows(&axes_a),
@@ -93,9 +93,7 @@ impl<R: Real> Obb<R> {
     fn distance_bound(&self, other: &Self, b_to_a: &Pose, enough: f64) -> (f64, f64) {
         if R::PRECISION == Precision::F32 {
             let tol = axis_tolerance(R::PRECISION);
-            let far = |offset_norm1: f64, halves: f64| {
-                4.0 * tol * offset_norm1 > FAR * SAT_GUARD * halves
-            };
+            let far = |offset_norm1, halves| frames_far_apart(tol, offset_norm1, halves);
             match super::pair_f32::distance_lower_bound_until(self, other, b_to_a, enough, far) {
                 Some((bound, centres, false)) => return (bound, centres),
                 Some((bound, centres, true)) => {
@@ -275,6 +273,14 @@ fn rounded_rows<R: Real>(frame: &Matrix3<f64>) -> [[R; 3]; 3] {
 /// leaves of a bunny 4 diagonals away were re-orthonormalised at every test, a
 /// measurable cost, for nothing.
 const FAR: f64 = 1e4;
+
+/// Whether a distance bound re-orthonormalises the frames (orthonormal within `tol`) of two
+/// boxes whose centres are `offset_norm1` apart (1-norm) and whose half-widths sum to
+/// `halves`: where the frames' share of the slack passes [`FAR`] times the guard's.
+#[inline(always)]
+fn frames_far_apart(tol: f64, offset_norm1: f64, halves: f64) -> bool {
+    4.0 * tol * offset_norm1 > FAR * SAT_GUARD * halves
+}
 
 /// The rows of `axes` made orthonormal in f64 (Gram–Schmidt, the third row as the cross
 /// product of the first two: a box is symmetric, so the sign of an axis does not matter).
