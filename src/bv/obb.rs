@@ -400,6 +400,46 @@ mod tests {
     use super::*;
     use crate::bv::box_corners;
 
+    /// `verify` refuses a stored box with any non-finite number, a negative half-width, or
+    /// axes further from orthonormal than the precision's tolerance (a tie is accepted);
+    /// a flat box is well formed.
+    #[test]
+    fn validate_names_each_defect() {
+        let good = Obb::<f64> {
+            axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            center: [1.0, -2.0, 3.0],
+            half: [1.0, 0.5, 0.0],
+        };
+        assert_eq!(good.validate(), Ok(()));
+        for k in 0..15 {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let mut b = good;
+                match k {
+                    0..9 => b.axes[k / 3][k % 3] = bad,
+                    9..12 => b.center[k - 9] = bad,
+                    _ => b.half[k - 12] = bad,
+                }
+                assert_eq!(b.validate(), Err(BvDefect::NotFinite), "{k}");
+            }
+        }
+        for k in 0..3 {
+            let mut b = good;
+            b.half[k] = -0.25;
+            assert_eq!(b.validate(), Err(BvDefect::NegativeExtent), "{k}");
+        }
+        let tol = axis_tolerance(Precision::F64);
+        for (lean, defect) in [(tol, None), (2.0 * tol, Some(BvDefect::AxesNotOrthonormal))] {
+            // Row 1 leaning towards row 0: their dot product is `lean` exactly.
+            let mut b = good;
+            b.axes[1][0] = lean;
+            assert_eq!(b.validate(), defect.map_or(Ok(()), Err), "{lean:e}");
+        }
+        // A row longer than a unit: its squared length is 1 + 4 tol.
+        let mut b = good;
+        b.axes[2][2] = 1.0 + 2.0 * tol;
+        assert_eq!(b.validate(), Err(BvDefect::AxesNotOrthonormal));
+    }
+
     /// Diameter, volume and surface area of a box of half-widths 1, 2, 3.
     #[test]
     fn box_measures_are_the_boxs() {

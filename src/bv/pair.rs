@@ -498,7 +498,7 @@ mod tests {
     /// Each half of a model pair's mapping slack bounds the error of mapping one point of
     /// B's ball into A's frame and taking its offset from a point of A's ball, measured in
     /// double-double arithmetic: under random rotations, for balls near the origin and
-    /// 1e6 from it, and translations of either size.
+    /// 1e6 from it, of radius 1e-3, 1 and 1e6, and translations small and large.
     #[test]
     fn the_mapping_slack_bounds_the_rounding_of_a_mapped_offset() {
         let two_sum = |a: f64, b: f64| {
@@ -509,17 +509,24 @@ mod tests {
         let mut rng = Rng::new(41);
         let mut worst = 0.0f64;
         for k in 0..3000 {
-            let (far_a, far_b, far_t) = [
-                (0.0, 0.0, 1.0),
-                (1e6, 0.0, 1e6),
-                (1e6, 1e6, 1.0),
-                (0.0, 1e6, 1e6),
-            ][k % 4];
+            let (far_a, far_b, far_t, size) = [
+                (0.0, 0.0, 1.0, 1.0),
+                (1e6, 0.0, 1e6, 1.0),
+                (1e6, 1e6, 1.0, 1.0),
+                (0.0, 1e6, 1e6, 1.0),
+                (0.0, 0.0, 1e6, 1.0),
+                (0.0, 0.0, 1.0, 1e6),
+                (0.0, 0.0, 1e6, 1e-3),
+                (0.0, 0.0, 1e-3, 1e-3),
+            ][k % 8];
             let point = |rng: &mut Rng, far: f64| {
                 Vector3::new(rng.signed(), rng.signed(), rng.signed()) + Vector3::repeat(far)
             };
-            let (ca, cb) = (point(&mut rng, far_a), point(&mut rng, far_b));
-            let (ra, rb) = (1.0 + rng.unit(), 1.0 + rng.unit());
+            let (ca, cb) = (
+                point(&mut rng, 0.0) * size + Vector3::repeat(far_a),
+                point(&mut rng, 0.0) * size + Vector3::repeat(far_b),
+            );
+            let (ra, rb) = ((1.0 + rng.unit()) * size, (1.0 + rng.unit()) * size);
             let b_to_a = Pose::new(rng.uniform_rotation(), point(&mut rng, 0.0) * far_t)
                 .expect("a rotation");
             let guard = Guard::for_models(SAT_GUARD, (ca.into(), ra), (cb.into(), rb), &b_to_a);
