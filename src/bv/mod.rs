@@ -563,6 +563,32 @@ pub(crate) fn turned_far_pose(rng: &mut crate::generate::Rng, k: usize) -> Pose 
     Pose::new(rng.uniform_rotation(), t).unwrap_or_default()
 }
 
+/// Exact arithmetic on doubles for the tests that judge rounding: `a + b` as an
+/// unevaluated sum of two doubles, exactly.
+#[cfg(test)]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let v = s - a;
+    (s, (a - (s - v)) + (b - v))
+}
+
+/// `a · b` as an unevaluated sum of two doubles, exactly (see [`two_sum`]).
+#[cfg(test)]
+pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    (p, a.mul_add(b, -p))
+}
+
+/// A sum of doubles as a double-double, to about 2⁻¹⁰⁰ of its largest term (see
+/// [`two_sum`]).
+#[cfg(test)]
+pub(crate) fn double_double_sum(terms: &[f64]) -> (f64, f64) {
+    terms.iter().fold((0.0, 0.0), |(hi, lo), &t| {
+        let (s, e) = two_sum(hi, t);
+        two_sum(s, lo + e)
+    })
+}
+
 /// The eight corners of the box `center + Σ ±half[i] · axes.row(i)`: for the tests of
 /// volumes that must hold a whole box.
 #[cfg(test)]

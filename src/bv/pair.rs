@@ -501,11 +501,6 @@ mod tests {
     /// 1e6 from it, of radius 1e-3, 1 and 1e6, and translations small and large.
     #[test]
     fn the_mapping_slack_bounds_the_rounding_of_a_mapped_offset() {
-        let two_sum = |a: f64, b: f64| {
-            let s = a + b;
-            let v = s - a;
-            (s, (a - (s - v)) + (b - v))
-        };
         let mut rng = Rng::new(41);
         let mut worst = 0.0f64;
         for k in 0..3000 {
@@ -539,16 +534,13 @@ mod tests {
             let (rotation, t) = (b_to_a.rotation(), b_to_a.translation_vector());
             for i in 0..3 {
                 // The exact offset less the computed one, as a sum of doubles, each term
-                // exact: the products' errors by fused multiply-add.
+                // exact.
                 let mut terms = vec![t[i], -p[i], -computed[i]];
                 for j in 0..3 {
-                    let product = rotation[(i, j)] * q[j];
-                    terms.extend([product, rotation[(i, j)].mul_add(q[j], -product)]);
+                    let (product, error) = crate::bv::two_prod(rotation[(i, j)], q[j]);
+                    terms.extend([product, error]);
                 }
-                let (hi, lo) = terms.iter().fold((0.0, 0.0), |(hi, lo), &t| {
-                    let (s, e) = two_sum(hi, t);
-                    two_sum(s, lo + e)
-                });
+                let (hi, lo) = crate::bv::double_double_sum(&terms);
                 let error = (hi + lo).abs();
                 assert!(
                     error <= guard.mapping / 2.0,

@@ -308,23 +308,7 @@ mod tests {
     /// that sum.
     #[test]
     fn spheres_posed_to_touch_overlap() {
-        // a + b and a * b as unevaluated sums of two doubles, exactly.
-        let two_sum = |a: f64, b: f64| {
-            let s = a + b;
-            let v = s - a;
-            (s, (a - (s - v)) + (b - v))
-        };
-        let two_prod = |a: f64, b: f64| {
-            let p = a * b;
-            (p, a.mul_add(b, -p))
-        };
-        // A sum of doubles, to about 2⁻¹⁰⁰ of its largest term.
-        let sum = |terms: &[f64]| {
-            terms.iter().fold((0.0, 0.0), |(hi, lo), &t| {
-                let (s, e) = two_sum(hi, t);
-                two_sum(s, lo + e)
-            })
-        };
+        use crate::bv::{double_double_sum as sum, two_prod, two_sum};
         let mut rng = Rng::new(23);
         let (mut touching, mut apart) = (0, 0);
         for k in 0..6000 {
