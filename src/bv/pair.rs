@@ -514,20 +514,18 @@ mod tests {
                 (0.0, 0.0, 1e6, 1e-3),
                 (0.0, 0.0, 1e-3, 1e-3),
             ][k % 8];
-            let point = |rng: &mut Rng, far: f64| {
-                Vector3::new(rng.signed(), rng.signed(), rng.signed()) + Vector3::repeat(far)
-            };
+            let signed = |rng: &mut Rng| Vector3::new(rng.signed(), rng.signed(), rng.signed());
             let (ca, cb) = (
-                point(&mut rng, 0.0) * size + Vector3::repeat(far_a),
-                point(&mut rng, 0.0) * size + Vector3::repeat(far_b),
+                signed(&mut rng) * size + Vector3::repeat(far_a),
+                signed(&mut rng) * size + Vector3::repeat(far_b),
             );
             let (ra, rb) = ((1.0 + rng.unit()) * size, (1.0 + rng.unit()) * size);
-            let b_to_a = Pose::new(rng.uniform_rotation(), point(&mut rng, 0.0) * far_t)
-                .expect("a rotation");
+            let b_to_a =
+                Pose::new(rng.uniform_rotation(), signed(&mut rng) * far_t).expect("a rotation");
             let guard = Guard::for_models(SAT_GUARD, (ca.into(), ra), (cb.into(), rb), &b_to_a);
             assert_eq!(guard.rotation, SAT_GUARD);
             // Points on the balls' surfaces, where the magnitudes are largest.
-            let direction = |rng: &mut Rng| point(rng, 0.0).normalize();
+            let direction = |rng: &mut Rng| signed(rng).normalize();
             let p = ca + direction(&mut rng) * ra;
             let q = cb + direction(&mut rng) * rb;
             let computed = b_to_a.apply(&q) - p;

@@ -846,8 +846,9 @@ fn near_contact_under_a_common_rotation_keeps_the_distance_error_bound() {
 /// pair the brute force finds on the coordinates as the query maps them must be found.
 /// Mapping B's box centres and corners into A's frame rounds by ulps of the coordinates
 /// (1e6 here), far more than the separating-axis guard's share of boxes 1e-5 across; the
-/// guard's mapping slack covers it at any size (f64 files: f32 cannot store triangles this
-/// small this far out).
+/// guard's mapping slack covers it at any size, and the builder's slack on stored
+/// half-widths covers most of it too (f64 files: f32 cannot store triangles this small
+/// this far out).
 #[test]
 fn small_triangles_resting_on_each_other_far_from_the_origin() {
     const FAR: f64 = 1e6;
