@@ -274,6 +274,7 @@ mod tests {
         let world = compact.world_aabb(&Pose::identity());
         let (ball, radius) = compact.enclosing_ball();
         let distance = |p: [f64; 3], q: [f64; 3]| crate::arr3::norm2(crate::arr3::sub(p, q)).sqrt();
+        assert!(!compact.contains([3.0, 0.0, 0.0], 0.0));
         for p in positions {
             assert!(compact.contains(p, 0.0), "{p:?} outside {compact:?}");
             for ((lo, hi), x) in world.min.iter().zip(world.max).zip(p) {
@@ -295,6 +296,34 @@ mod tests {
         assert_eq!(compact.surface_area(), decoded.surface_area());
         assert_eq!(compact.thickness(), decoded.thickness());
         assert!(0.0 < compact.thickness() && compact.thickness() <= compact.diameter());
+    }
+
+    /// A damaged compact box is refused for what it decodes to: a negative or NaN
+    /// half-width, or a quaternion far from unit length (its frame is not orthonormal).
+    #[test]
+    fn damaged_compact_boxes_are_refused() {
+        let sound = CompactObb {
+            center: [0.5, -1.0, 2.0],
+            rotation: quantise_frame(&Rotation3::from_euler_angles(0.3, -1.2, 2.9).into_inner()),
+            half: [1.0f32, 0.5, 0.25].map(bf16_up),
+            pad: 0,
+        };
+        assert_eq!(sound.validate(), Ok(()));
+        let negative = CompactObb {
+            half: [1.0f32, -0.5, 0.25].map(|h| (h.to_bits() >> 16) as u16),
+            ..sound
+        };
+        assert_eq!(negative.validate(), Err(BvDefect::NegativeExtent));
+        let not_a_number = CompactObb {
+            half: [0x7FC0, 0x3F80, 0x3F80],
+            ..sound
+        };
+        assert_eq!(not_a_number.validate(), Err(BvDefect::NotFinite));
+        let long = CompactObb {
+            rotation: [32767, 32767, 32767, 0],
+            ..sound
+        };
+        assert_eq!(long.validate(), Err(BvDefect::AxesNotOrthonormal));
     }
 
     #[test]

@@ -1,8 +1,9 @@
-//! The exact work of fixed queries, pinned for every volume type: the BVTT statistics of
-//! §2.6 (box tests disjoint D and overlapping I, triangle pairs separated S and in contact
-//! K, node pairs visited) of all-pairs and first-contact collision, exact and `rel_err`
-//! distance, tolerance and span queries, on sliding spheres (apart, grazing, deep,
-//! concentric) and on the bundled cow against a turned copy.
+//! The exact work of fixed queries, pinned for every volume type and for the compact
+//! layout's quantised boxes: the BVTT statistics of §2.6 (box tests disjoint D and
+//! overlapping I, triangle pairs separated S and in contact K, node pairs visited) of
+//! all-pairs and first-contact collision, exact and `rel_err` distance, tolerance and span
+//! queries, on sliding spheres (apart, grazing, deep, concentric) and on the bundled cow
+//! against a turned copy.
 //!
 //! The one-model queries (rays, closest points and winding numbers, which descend the
 //! surface index rather than the tree) have a table of their own, in the counts each
@@ -25,8 +26,7 @@ mod rays;
 
 use nalgebra::Vector3;
 use obbtree::build::{build, BuildOptions};
-use obbtree::bv::BvKind;
-use obbtree::format::ObbtFile;
+use obbtree::bv::{BvKind, Layout};
 use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{
@@ -35,7 +35,8 @@ use obbtree::query::{
     ToleranceOptions, WindingAccuracy, WindingOptions, Work,
 };
 
-/// `(query, [D, I, S, K, node pairs visited])`, volume type first in the name.
+/// `(query, [D, I, S, K, node pairs visited])`, the kind of tree ([`tree_options`]) first
+/// in the name.
 #[rustfmt::skip]
 const PINNED: &[(&str, [u64; 5])] = &[
     ("obb all pairs x=0.3", [2750, 3385, 156, 162, 6135]),
@@ -80,12 +81,28 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("sphere distance rel_err=0.01 x=2", [1395, 3796, 1201, 0, 5191]),
     ("sphere tolerance 0.05 x=1.83", [245, 500, 60, 0, 745]),
     ("sphere span x=1", [13647, 54322, 20338, 0, 67969]),
+    ("compact all pairs x=0.3", [2768, 3405, 157, 162, 6173]),
+    ("compact all pairs x=0.6", [2267, 3184, 239, 220, 5451]),
+    ("compact all pairs x=1", [1687, 2394, 168, 186, 4081]),
+    ("compact all pairs x=1.7", [683, 934, 68, 58, 1617]),
+    ("compact all pairs x=0.6 --rule volume", [2269, 3180, 236, 220, 5449]),
+    ("compact all pairs x=0.6 --rule area", [2257, 3176, 240, 220, 5433]),
+    ("compact all pairs x=0.6 --rule a", [5287, 6328, 301, 220, 11615]),
+    ("compact all pairs x=0.6 --rule b", [11204, 12123, 240, 220, 23327]),
+    ("compact first contact x=0.6", [0, 23, 0, 1, 23]),
+    ("compact first contact x=1", [14, 37, 0, 1, 51]),
+    ("compact distance rel_err=0 x=2", [653, 800, 74, 0, 1453]),
+    ("compact distance rel_err=0.01 x=2", [645, 758, 57, 0, 1403]),
+    ("compact tolerance 0.05 x=1.83", [29, 56, 1, 0, 85]),
+    ("compact span x=1", [3249, 3780, 266, 0, 7029]),
     ("obb concentric distance rel_err=0", [22859, 26694, 1918, 0, 49553]),
     ("obb concentric distance rel_err=0.01", [22622, 25725, 1552, 0, 48347]),
     ("aabb concentric distance rel_err=0", [19542, 70615, 25537, 0, 90157]),
     ("aabb concentric distance rel_err=0.01", [19484, 70229, 25373, 0, 89713]),
     ("sphere concentric distance rel_err=0", [19452, 89593, 35071, 0, 109045]),
     ("sphere concentric distance rel_err=0.01", [19432, 89229, 34899, 0, 108661]),
+    ("compact concentric distance rel_err=0", [23024, 26953, 1965, 0, 49977]),
+    ("compact concentric distance rel_err=0.01", [22803, 25956, 1577, 0, 48759]),
     ("obb cow all pairs", [1735, 2576, 242, 179, 4311]),
     ("obb cow first contact", [4, 28, 0, 1, 32]),
     ("obb cow distance rel_err=0", [158, 345, 94, 0, 503]),
@@ -98,6 +115,10 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("sphere cow first contact", [70, 101, 4, 1, 171]),
     ("sphere cow distance rel_err=0", [141, 400, 130, 0, 541]),
     ("sphere cow distance rel_err=0.01", [131, 184, 27, 0, 315]),
+    ("compact cow all pairs", [1742, 2589, 245, 179, 4331]),
+    ("compact cow first contact", [4, 28, 0, 1, 32]),
+    ("compact cow distance rel_err=0", [159, 346, 94, 0, 505]),
+    ("compact cow distance rel_err=0.01", [158, 165, 4, 0, 323]),
 ];
 
 /// One query of the table: its name and what it runs.
@@ -263,31 +284,46 @@ fn cow_cases() -> Vec<Case> {
     ]
 }
 
-fn tree(mesh: &TriMesh, bv: BvKind) -> ObbtFile {
-    let options = BuildOptions {
-        bv,
+/// The trees of the table, by the name its rows start with: each volume type at the default
+/// options, and the quantised boxes of the compact layout (one face per leaf, so that the
+/// identity of complete traversals holds for it too).
+fn tree_options() -> Vec<(&'static str, BuildOptions)> {
+    let mut out: Vec<_> = BvKind::ALL
+        .into_iter()
+        .map(|bv| {
+            let options = BuildOptions {
+                bv,
+                ..BuildOptions::default()
+            };
+            (bv.name(), options)
+        })
+        .collect();
+    let compact = BuildOptions {
+        layout: Layout::Compact,
         ..BuildOptions::default()
     };
-    build(mesh, &options, None).expect("builds")
+    out.push(("compact", compact));
+    out
 }
 
-/// Runs `cases` between trees of `a` and `b` of every volume type.
+/// Runs `cases` between trees of `a` and `b` of every kind of [`tree_options`].
 fn run(a: &TriMesh, b: &TriMesh, cases: &[Case], out: &mut Vec<(String, [u64; 5])>) {
-    for bv in BvKind::ALL {
-        let (ta, tb) = (tree(a, bv), tree(b, bv));
-        let mut pair = PairQuery::new(&ta, &tb).expect("one volume type");
+    for (kind, options) in tree_options() {
+        let ta = build(a, &options, None).expect("builds");
+        let tb = build(b, &options, None).expect("builds");
+        let mut pair = PairQuery::new(&ta, &tb).expect("one kind of tree");
         for case in cases {
             let s = (case.run)(&mut pair);
             if case.complete {
-                assert_eq!(s.identity_value(), 1, "{} {}: {s:?}", bv.name(), case.name);
+                assert_eq!(s.identity_value(), 1, "{kind} {}: {s:?}", case.name);
             }
-            out.push((format!("{} {}", bv.name(), case.name), counts(&s)));
+            out.push((format!("{kind} {}", case.name), counts(&s)));
         }
     }
 }
 
 #[test]
-fn the_work_of_fixed_queries_is_pinned_for_every_volume_type() {
+fn the_work_of_fixed_queries_is_pinned_for_every_kind_of_tree() {
     let mut actual = Vec::new();
     let (big, small) = (
         common::uv_sphere(1.0, 21, 40),
@@ -382,7 +418,7 @@ fn total<'a>(works: impl Iterator<Item = &'a Work>) -> [u64; 5] {
 #[test]
 fn the_work_of_one_model_queries_is_pinned() {
     let mesh = common::cow();
-    let cow = tree(&mesh, BvKind::Obb);
+    let cow = build(&mesh, &BuildOptions::default(), None).expect("builds");
     let pose = common::turned_pose(5, 0.7);
     let rays = cow_rays(&mesh, &pose);
     let mut actual = Vec::new();
