@@ -400,6 +400,56 @@ mod tests {
     use super::*;
     use crate::bv::box_corners;
 
+    /// The boxes the builder fits hold every point and are tight, in both precisions and
+    /// far from the origin: centred on the middle of the points' projections, each
+    /// half-width their half-range plus rounding. The one-pass fit of a frame and the
+    /// model's axes gives exactly the boxes fitted along each alone (the model's axes
+    /// include a negated one when the spreads are in odd order).
+    #[test]
+    fn enclosed_boxes_hold_their_points_and_are_tight() {
+        fn check<R: Real>(spread: [f64; 3], offset: f64, tolerance: f64) {
+            let mut state = 0x2545_F491_4F6C_DD1Du64;
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+            };
+            let points: Vec<[f64; 3]> = (0..40)
+                .map(|_| std::array::from_fn(|k| offset + spread[k] * next()))
+                .collect();
+            let frame = nalgebra::Rotation3::from_euler_angles(0.4, -0.9, 2.2).into_inner();
+            let fitted = Obb::<R>::enclose_points(&frame, points.iter());
+            let [(f, both_fitted), (model, aligned)] =
+                Obb::<R>::enclose_points_fitted_and_aligned(&frame, points.iter());
+            assert_eq!(f, frame);
+            assert_eq!(both_fitted, fitted);
+            assert_eq!(aligned, Obb::<R>::enclose_points(&model, points.iter()));
+            let scale = offset.abs() + spread.iter().fold(0.0f64, |m, s| m.max(*s));
+            for b in [fitted, aligned] {
+                for p in &points {
+                    assert!(b.contains(*p, 0.0), "{p:?} outside {b:?}");
+                }
+                let (c, h) = (b.center_f64(), b.half_f64());
+                for (axis, h) in b.axes_f64().into_iter().zip(h) {
+                    let (lo, hi) = points.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                        let d = dot(axis, *p);
+                        (lo.min(d), hi.max(d))
+                    });
+                    let off_middle = (dot(axis, c) - 0.5 * (lo + hi)).abs();
+                    assert!(off_middle <= tolerance * scale, "{off_middle:e} {b:?}");
+                    assert!(h <= 0.5 * (hi - lo) + tolerance * scale, "{h} {b:?}");
+                }
+            }
+        }
+        for offset in [0.0, -40.0, 1e5] {
+            for spread in [[3.0, 1.0, 0.2], [1.0, 3.0, 0.2]] {
+                check::<f64>(spread, offset, 1e-13);
+                check::<f32>(spread, offset, 1e-6);
+            }
+        }
+    }
+
     /// `verify` refuses a stored box with any non-finite number, a negative half-width, or
     /// axes further from orthonormal than the precision's tolerance (a tie is accepted);
     /// a flat box is well formed.
