@@ -236,4 +236,63 @@ mod tests {
             );
         }
     }
+
+    /// An option must be greater than 0: zero, negatives and NaN are refused by name, and
+    /// the value is shown as Rust prints it unless that is a long run of digits.
+    #[test]
+    fn options_are_refused_with_their_value_shown_readably() {
+        assert_eq!(require_positive("rel_err", 0.5), Ok(()));
+        for (value, text) in [
+            (0.0, "0"),
+            (-2.5, "-2.5"),
+            (f64::NAN, "NaN"),
+            (f64::NEG_INFINITY, "-inf"),
+            (-1e-7, "-1e-7"),
+            (-3e20, "-3e20"),
+        ] {
+            let err = require_positive("rel_err", value).expect_err("refused");
+            assert_eq!(
+                err.to_string(),
+                format!("rel_err must be greater than 0, got {text}")
+            );
+        }
+        for (value, text) in [
+            (1e-5, "0.00001"),
+            (2.5e15, "2500000000000000"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(shown(value), text);
+        }
+    }
+
+    /// Query points must be finite and, once posed in the model's frame, within
+    /// [`MAX_COORDINATE`]: the first bad one is named by its index and coordinate.
+    #[test]
+    fn query_points_are_checked_in_the_models_frame() {
+        assert!(within_reach(MAX_COORDINATE) && within_reach(-MAX_COORDINATE));
+        assert!(!within_reach(2.0 * MAX_COORDINATE) && !within_reach(f64::NAN));
+        let near = [[0.0, 1.0, 2.0], [0.0, 0.0, 1e149]];
+        assert_eq!(check_points(&near, &Pose::identity()), Ok(()));
+        let not_finite = [[0.0; 3], [0.0, f64::NAN, 1.0]];
+        let err = check_points(&not_finite, &Pose::identity()).expect_err("NaN");
+        assert_eq!(
+            err.to_string(),
+            "query point 1: coordinates must be finite, got NaN"
+        );
+        let moved = Pose::new(
+            nalgebra::Matrix3::identity(),
+            nalgebra::Vector3::new(0.0, 0.0, 9.5e149),
+        )
+        .expect("a pose");
+        let err = check_points(&near, &moved).expect_err("beyond reach once posed");
+        assert_eq!(
+            err,
+            QueryError::BadInput {
+                what: "query point",
+                index: 1,
+                requirement: WITHIN_REACH,
+                value: 1e149 + 9.5e149,
+            }
+        );
+    }
 }
