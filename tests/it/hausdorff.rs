@@ -576,6 +576,49 @@ fn a_peak_inside_a_face_is_found_by_its_probes() {
     assert_eq!(h.work.nodes_visited, 361, "{:?}", h.work);
 }
 
+/// The right isosceles triangle with legs 1 over three small triangles, one at each of its
+/// corners and pointing away from it: the farthest point is the midpoint of the hypotenuse,
+/// √½ from all three corners, and only the split's midpoints reach it (the middles of the
+/// pieces are inside them).
+#[test]
+fn a_peak_at_an_edge_midpoint_is_found_by_the_split() {
+    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let face = TriMesh::new(corners.to_vec(), vec![[0, 1, 2]]).expect("a triangle");
+    // Each dot's edges leave its corner at an obtuse angle to every direction into the
+    // face, so the corner is the dot's nearest point to all of it.
+    let v = vec![
+        [0.0, 0.0, 0.0],
+        [-1.0, -0.1, 0.0],
+        [-0.1, -1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, -0.1, 0.0],
+        [1.1, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-0.1, 2.0, 0.0],
+        [-1.0, 1.1, 0.0],
+    ];
+    let dots = TriMesh::new(v, vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]]).expect("three dots");
+    let (a, b) = (
+        build(&face, &BuildOptions::default(), None).expect("builds"),
+        build(&dots, &BuildOptions::default(), None).expect("builds"),
+    );
+    let id = Pose::identity();
+    let h = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
+    let (ta, tb) = (world_triangles(&a, &id), world_triangles(&b, &id));
+    check(
+        &h,
+        &ta,
+        &tb,
+        (sampled(&ta, &tb, 40), 0.0),
+        &HausdorffOptions::default(),
+        0.0,
+        "face over outward dots",
+    );
+    assert_eq!(h.point_a, [0.5, 0.5, 0.0], "{h:?}");
+    assert!((h.distance - 0.5f64.sqrt()).abs() <= 1e-15, "{h:?}");
+    assert_eq!(h.work.nodes_visited, 34, "{:?}", h.work);
+}
+
 /// The unit square triangulated along the other diagonal than [`square`]'s, with its
 /// corner (1, 1) raised by `lift`.
 fn flipped_square(lift: f64) -> ObbtFile {
