@@ -499,9 +499,9 @@ mod tests {
         assert_eq!(area, 88.0);
     }
 
-    /// A box along f32 axes (orthonormal only within their tolerance) lies inside the box of
-    /// widened half-widths along the axes made orthonormal: every corner, for boxes of
-    /// several sizes and shapes in random frames.
+    /// Axes made orthonormal are so to rounding, and a box along f32 axes (orthonormal only
+    /// within their tolerance) lies inside the box of widened half-widths along them: every
+    /// corner, for boxes of several sizes and shapes in random frames.
     #[test]
     fn widened_half_widths_hold_the_box_along_orthonormal_axes() {
         let mut rng = crate::generate::Rng::new(29);
@@ -517,6 +517,20 @@ mod tests {
             };
             let (axes, h) = (b.axes_matrix(), Vector3::from(b.half_f64()));
             let (q, wide) = (orthonormal_rows(&axes), widen(h, tol));
+            // Orthonormal to rounding (the stored rows are only within `tol`), each row the
+            // stored one's direction but for the third's sign.
+            let gram = q * q.transpose();
+            assert!(
+                (gram - Matrix3::identity()).abs().max() < 1e-14,
+                "case {k}: {gram}"
+            );
+            for j in 0..3 {
+                let along = q.row(j).dot(&axes.row(j)).abs();
+                assert!(
+                    along >= 1.0 - 3.0 * tol,
+                    "case {k}: row {j} turned: {along}"
+                );
+            }
             for (corner, p) in box_corners(&Vector3::zeros(), &axes, &h).iter().enumerate() {
                 for j in 0..3 {
                     let along = q.row(j).transpose().dot(p);
