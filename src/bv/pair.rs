@@ -502,7 +502,7 @@ mod tests {
     #[test]
     fn the_mapping_slack_bounds_the_rounding_of_a_mapped_offset() {
         let mut rng = Rng::new(41);
-        let mut worst = 0.0f64;
+        let mut worst = [0.0f64; 8];
         for k in 0..3000 {
             let (far_a, far_b, far_t, size) = [
                 (0.0, 0.0, 1.0, 1.0),
@@ -544,12 +544,16 @@ mod tests {
                     error <= guard.mapping / 2.0,
                     "case {k}: error {error:e}, {guard:?}"
                 );
-                worst = worst.max(error / guard.mapping);
+                worst[k % 8] = worst[k % 8].max(error / guard.mapping);
             }
         }
-        // A bound of the rounding, not a multiple of the coordinates (catches a slack
-        // inflated by orders of magnitude, which would open far more box pairs).
-        assert!(worst > 1e-3, "worst error {worst:e} of the slack");
+        // A bound of the rounding, not a multiple of the coordinates, in every kind of case
+        // (catches a slack inflated by orders of magnitude, which would open far more box
+        // pairs).
+        assert!(
+            worst.iter().all(|w| *w > 5e-4),
+            "worst errors {worst:?} of the slack"
+        );
     }
 
     /// The mapping slack widens every comparison of the box tests: boxes side by side
