@@ -30,9 +30,9 @@ use obbtree::bv::{BvKind, Layout};
 use obbtree::generate::Rng;
 use obbtree::mesh::TriMesh;
 use obbtree::query::{
-    all_ray_hits, cast_rays, closest_points, winding_numbers, ClosestOptions, CollideOptions,
-    DescentRule, DistanceOptions, PairQuery, Pose, Ray, RayMode, RayOptions, SpanOptions,
-    ToleranceOptions, WindingAccuracy, WindingOptions, Work,
+    all_ray_hits, cast_rays, closest_points, winding_numbers, BoxTest, ClosestOptions,
+    CollideOptions, DescentRule, DistanceOptions, PairQuery, Pose, Ray, RayMode, RayOptions,
+    SpanOptions, ToleranceOptions, WindingAccuracy, WindingOptions, Work,
 };
 
 /// `(query, [D, I, S, K, node pairs visited])`, the kind of tree ([`tree_options`]) first
@@ -52,6 +52,8 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("obb distance rel_err=0 x=2", [531, 674, 72, 0, 1205]),
     ("obb distance rel_err=0.01 x=2", [534, 639, 53, 0, 1173]),
     ("obb tolerance 0.05 x=1.83", [29, 56, 1, 0, 85]),
+    ("obb all pairs x=0.6 --box-test rewrapped", [3968, 5953, 773, 220, 9921]),
+    ("obb distance max_distance=0.05 x=3", [1, 0, 0, 0, 1]),
     ("obb span x=1", [3215, 3736, 261, 0, 6951]),
     ("aabb all pairs x=0.3", [6885, 13092, 2942, 162, 19977]),
     ("aabb all pairs x=0.6", [5305, 9920, 2088, 220, 15225]),
@@ -66,6 +68,8 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("aabb distance rel_err=0 x=2", [1026, 1935, 455, 0, 2961]),
     ("aabb distance rel_err=0.01 x=2", [1020, 1889, 435, 0, 2909]),
     ("aabb tolerance 0.05 x=1.83", [20, 59, 2, 0, 79]),
+    ("aabb all pairs x=0.6 --box-test rewrapped", [7367, 13334, 2764, 220, 20701]),
+    ("aabb distance max_distance=0.05 x=3", [1, 0, 0, 0, 1]),
     ("aabb span x=1", [12213, 29644, 8716, 0, 41857]),
     ("sphere all pairs x=0.3", [10209, 24436, 6952, 162, 34645]),
     ("sphere all pairs x=0.6", [7867, 18320, 5007, 220, 26187]),
@@ -80,6 +84,8 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("sphere distance rel_err=0 x=2", [1408, 3869, 1231, 0, 5277]),
     ("sphere distance rel_err=0.01 x=2", [1395, 3796, 1201, 0, 5191]),
     ("sphere tolerance 0.05 x=1.83", [245, 500, 60, 0, 745]),
+    ("sphere all pairs x=0.6 --box-test rewrapped", [7867, 18320, 5007, 220, 26187]),
+    ("sphere distance max_distance=0.05 x=3", [1, 0, 0, 0, 1]),
     ("sphere span x=1", [13647, 54322, 20338, 0, 67969]),
     ("compact all pairs x=0.3", [2768, 3405, 157, 162, 6173]),
     ("compact all pairs x=0.6", [2267, 3184, 239, 220, 5451]),
@@ -94,6 +100,8 @@ const PINNED: &[(&str, [u64; 5])] = &[
     ("compact distance rel_err=0 x=2", [653, 800, 74, 0, 1453]),
     ("compact distance rel_err=0.01 x=2", [645, 758, 57, 0, 1403]),
     ("compact tolerance 0.05 x=1.83", [29, 56, 1, 0, 85]),
+    ("compact all pairs x=0.6 --box-test rewrapped", [4007, 6020, 787, 220, 10027]),
+    ("compact distance max_distance=0.05 x=3", [1, 0, 0, 0, 1]),
     ("compact span x=1", [3249, 3780, 266, 0, 7029]),
     ("obb concentric distance rel_err=0", [22859, 26694, 1918, 0, 49553]),
     ("obb concentric distance rel_err=0.01", [22622, 25725, 1552, 0, 48347]),
@@ -219,6 +227,33 @@ fn sphere_cases() -> Vec<Case> {
             };
             pair.within(&Pose::identity(), &pose, &options)
                 .expect("tolerance")
+                .work
+        }),
+        complete: false,
+    });
+    cases.push(Case {
+        name: "all pairs x=0.6 --box-test rewrapped".into(),
+        run: Box::new(|pair| {
+            let options = CollideOptions {
+                box_test: BoxTest::Rewrapped,
+                ..CollideOptions::default()
+            };
+            pair.collide(&Pose::identity(), &common::sliding_pose(0.6, 5), &options)
+                .expect("collide")
+                .work
+        }),
+        complete: true,
+    });
+    // Apart by more than the limit: the root pair's bound alone answers.
+    cases.push(Case {
+        name: "distance max_distance=0.05 x=3".into(),
+        run: Box::new(|pair| {
+            let options = DistanceOptions {
+                max_distance: 0.05,
+                ..DistanceOptions::default()
+            };
+            pair.distance(&Pose::identity(), &common::sliding_pose(3.0, 5), &options)
+                .expect("distance")
                 .work
         }),
         complete: false,
