@@ -408,15 +408,9 @@ mod tests {
     #[test]
     fn enclosed_boxes_hold_their_points_and_are_tight() {
         fn check<R: Real>(spread: [f64; 3], offset: f64, tolerance: f64) {
-            let mut state = 0x2545_F491_4F6C_DD1Du64;
-            let mut next = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-            };
+            let mut rng = crate::generate::Rng::new(31);
             let points: Vec<[f64; 3]> = (0..40)
-                .map(|_| std::array::from_fn(|k| offset + spread[k] * next()))
+                .map(|_| std::array::from_fn(|k| offset + spread[k] * rng.signed()))
                 .collect();
             let frame = nalgebra::Rotation3::from_euler_angles(0.4, -0.9, 2.2).into_inner();
             let fitted = Obb::<R>::enclose_points(&frame, points.iter());

@@ -537,6 +537,30 @@ fn a_ridge_between_two_faces_is_closed_exactly() {
 /// away from the peak close against it; the work is pinned. Refinement finds the rest, and
 /// the bounds close to rounding (`check` with no floor gap): the last few ulps by the probe
 /// of a piece at the floor.
+/// h(face, dots) at the default options, for a one-triangle `face` over three small
+/// triangles of corners `dots` (three each), checked against brute force (`name` in its
+/// messages).
+fn face_over_dots(face: &TriMesh, dots: Vec<[f64; 3]>, name: &str) -> HausdorffResult {
+    let dots = TriMesh::new(dots, vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]]).expect("three dots");
+    let (a, b) = (
+        build(face, &BuildOptions::default(), None).expect("builds"),
+        build(&dots, &BuildOptions::default(), None).expect("builds"),
+    );
+    let (id, options) = (Pose::identity(), HausdorffOptions::default());
+    let h = hausdorff(&a, &id, &b, &id, &options).expect("answers");
+    let (ta, tb) = (world_triangles(&a, &id), world_triangles(&b, &id));
+    check(
+        &h,
+        &ta,
+        &tb,
+        (sampled(&ta, &tb, 40), 0.0),
+        &options,
+        0.0,
+        name,
+    );
+    h
+}
+
 #[test]
 fn a_peak_inside_a_face_is_found_by_its_probes() {
     let s = 3f64.sqrt();
@@ -552,25 +576,9 @@ fn a_peak_inside_a_face_is_found_by_its_probes() {
             [x + 0.05 * inward[0], y + 0.05 * inward[1] + 0.02, -0.01],
         ]);
     }
-    let dots = TriMesh::new(v, vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]]).expect("three dots");
-    let (a, b) = (
-        build(&face, &BuildOptions::default(), None).expect("builds"),
-        build(&dots, &BuildOptions::default(), None).expect("builds"),
-    );
-    let id = Pose::identity();
-    let h = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
+    let h = face_over_dots(&face, v, "face over dots");
     let centre = [1.0, s / 3.0, 0.0];
     let off = Vector3::from(h.point_a) - Vector3::from(centre);
-    let (ta, tb) = (world_triangles(&a, &id), world_triangles(&b, &id));
-    check(
-        &h,
-        &ta,
-        &tb,
-        (sampled(&ta, &tb, 40), 0.0),
-        &HausdorffOptions::default(),
-        0.0,
-        "face over dots",
-    );
     // (Near the centre: the dots are not quite alike as it sees them.)
     assert!(off.norm() <= 0.05, "the witness is off the centre: {h:?}");
     assert_eq!(h.work.nodes_visited, 361, "{:?}", h.work);
@@ -597,23 +605,7 @@ fn a_peak_at_an_edge_midpoint_is_found_by_the_split() {
         [-0.1, 2.0, 0.0],
         [-1.0, 1.1, 0.0],
     ];
-    let dots = TriMesh::new(v, vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]]).expect("three dots");
-    let (a, b) = (
-        build(&face, &BuildOptions::default(), None).expect("builds"),
-        build(&dots, &BuildOptions::default(), None).expect("builds"),
-    );
-    let id = Pose::identity();
-    let h = hausdorff(&a, &id, &b, &id, &HausdorffOptions::default()).expect("answers");
-    let (ta, tb) = (world_triangles(&a, &id), world_triangles(&b, &id));
-    check(
-        &h,
-        &ta,
-        &tb,
-        (sampled(&ta, &tb, 40), 0.0),
-        &HausdorffOptions::default(),
-        0.0,
-        "face over outward dots",
-    );
+    let h = face_over_dots(&face, v, "face over outward dots");
     assert_eq!(h.point_a, [0.5, 0.5, 0.0], "{h:?}");
     assert!((h.distance - 0.5f64.sqrt()).abs() <= 1e-15, "{h:?}");
     assert_eq!(h.work.nodes_visited, 34, "{:?}", h.work);
