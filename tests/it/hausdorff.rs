@@ -531,12 +531,6 @@ fn a_ridge_between_two_faces_is_closed_exactly() {
     }
 }
 
-/// An equilateral triangle A over three small triangles B at its corners: h(A, B) peaks
-/// inside the face, near its centre, where the first probe of A's piece (its centroid)
-/// measures most of it. That measurement raises the lower bound at once, so the pieces
-/// away from the peak close against it; the work is pinned. Refinement finds the rest, and
-/// the bounds close to rounding (`check` with no floor gap): the last few ulps by the probe
-/// of a piece at the floor.
 /// h(face, dots) at the default options, for a one-triangle `face` over three small
 /// triangles of corners `dots` (three each), checked against brute force (`name` in its
 /// messages).
@@ -561,6 +555,12 @@ fn face_over_dots(face: &TriMesh, dots: Vec<[f64; 3]>, name: &str) -> HausdorffR
     h
 }
 
+/// An equilateral triangle A over three small triangles B at its corners: h(A, B) peaks
+/// inside the face, near its centre, where the first probe of A's piece (its centroid)
+/// measures most of it. That measurement raises the lower bound at once, so the pieces
+/// away from the peak close against it; the work is pinned. Refinement finds the rest, and
+/// the bounds close to rounding (`check` with no floor gap): the last few ulps by the probe
+/// of a piece at the floor.
 #[test]
 fn a_peak_inside_a_face_is_found_by_its_probes() {
     let s = 3f64.sqrt();

@@ -178,19 +178,23 @@ fn first_contact(name: String, pose: Pose) -> Case {
     }
 }
 
-fn distance(name: String, pose: Pose, rel_err: f64, complete: bool) -> Case {
+fn distance(name: String, pose: Pose, options: DistanceOptions, complete: bool) -> Case {
     Case {
         name,
         run: Box::new(move |pair| {
-            let options = DistanceOptions {
-                rel_err,
-                ..DistanceOptions::default()
-            };
             pair.distance(&Pose::identity(), &pose, &options)
                 .expect("distance")
                 .work
         }),
         complete,
+    }
+}
+
+/// Exact distance (`rel_err` 0) or within `rel_err`, the other options at their defaults.
+fn relative(rel_err: f64) -> DistanceOptions {
+    DistanceOptions {
+        rel_err,
+        ..DistanceOptions::default()
     }
 }
 
@@ -213,7 +217,7 @@ fn sphere_cases() -> Vec<Case> {
         cases.push(distance(
             format!("distance rel_err={rel_err} x=2"),
             common::sliding_pose(2.0, 5),
-            rel_err,
+            relative(rel_err),
             true,
         ));
     }
@@ -245,19 +249,16 @@ fn sphere_cases() -> Vec<Case> {
         complete: true,
     });
     // Apart by more than the limit: the root pair's bound alone answers.
-    cases.push(Case {
-        name: "distance max_distance=0.05 x=3".into(),
-        run: Box::new(|pair| {
-            let options = DistanceOptions {
-                max_distance: 0.05,
-                ..DistanceOptions::default()
-            };
-            pair.distance(&Pose::identity(), &common::sliding_pose(3.0, 5), &options)
-                .expect("distance")
-                .work
-        }),
-        complete: false,
-    });
+    let limited = DistanceOptions {
+        max_distance: 0.05,
+        ..DistanceOptions::default()
+    };
+    cases.push(distance(
+        "distance max_distance=0.05 x=3".into(),
+        common::sliding_pose(3.0, 5),
+        limited,
+        false,
+    ));
     cases.push(Case {
         name: "span x=1".into(),
         run: Box::new(|pair| {
@@ -284,7 +285,7 @@ fn concentric_cases() -> Vec<Case> {
             distance(
                 format!("concentric distance rel_err={rel_err}"),
                 turned,
-                rel_err,
+                relative(rel_err),
                 true,
             )
         })
@@ -307,13 +308,13 @@ fn cow_cases() -> Vec<Case> {
         distance(
             "cow distance rel_err=0".into(),
             common::turned_pose(4, 1.5),
-            0.0,
+            relative(0.0),
             true,
         ),
         distance(
             "cow distance rel_err=0.01".into(),
             common::turned_pose(4, 1.5),
-            0.01,
+            relative(0.01),
             true,
         ),
     ]
