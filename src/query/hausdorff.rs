@@ -1337,16 +1337,12 @@ fn bound<B: BoundingVolume>(
                 }
             }
         }
-        // A piece parked under a small allowance (below `FINEST`) splits on once the lower
-        // bound has grown the allowance past its size.
         let lower = witness.near.distance;
         for piece in std::mem::take(&mut parked) {
-            if piece.upper <= enough(lower) {
-                upper = upper.max(piece.upper);
-            } else if longest(&piece) > floor(lower) {
-                heap.push(piece);
-            } else {
-                parked.push(piece);
+            match unpark(piece.upper, longest(&piece), enough(lower), floor(lower)) {
+                Unpark::Within => upper = upper.max(piece.upper),
+                Unpark::Split => heap.push(piece),
+                Unpark::Stays => parked.push(piece),
             }
         }
         if heap.is_empty() {
@@ -1365,6 +1361,32 @@ fn bound<B: BoundingVolume>(
         to_triangle: witness.near.id,
         work,
     })
+}
+
+/// What becomes of a parked piece once the search has a lower bound on h again.
+#[derive(Debug, PartialEq, Eq)]
+enum Unpark {
+    /// Its upper bound is within the error allowed: it only counts toward the upper bound.
+    Within,
+    /// It is longer than the split floor now is: back to splitting.
+    Split,
+    /// Still too small to split, and not yet within the allowance.
+    Stays,
+}
+
+/// The fate of a parked piece whose bound is `upper` and longest edge `longest`, where the
+/// search's answer is good enough up to `enough` and pieces are split down to `floor` (all
+/// world units). A piece parked under a small allowance (below [`FINEST`] of the diagonal,
+/// so split only down to [`FLOOR`] of it) splits on once the lower bound has grown the
+/// allowance past `FINEST` and the piece's size.
+fn unpark(upper: f64, longest: f64, enough: f64, floor: f64) -> Unpark {
+    if upper <= enough {
+        Unpark::Within
+    } else if longest > floor {
+        Unpark::Split
+    } else {
+        Unpark::Stays
+    }
 }
 
 #[cfg(test)]
@@ -1399,6 +1421,42 @@ mod tests {
         };
         assert_eq!(split_floor(&relative, d, d), 1e-6 * d);
         assert_eq!(split_floor(&relative, 1.0, d), floor);
+    }
+
+    /// A piece parked while a relative error allowed almost nothing (h about 0, so split
+    /// only to `FLOOR` of the diagonal) splits again once the lower bound has grown that
+    /// allowance past `FINEST` of the diagonal and past the piece; it is done once its bound
+    /// is within the allowance, and stays parked while it is shorter than the floor.
+    #[test]
+    fn a_parked_piece_splits_again_once_the_allowance_passes_it() {
+        let d = 1000.0;
+        let options = HausdorffOptions {
+            rel_err: 1e-3,
+            ..HausdorffOptions::default()
+        };
+        let floor = |lower| split_floor(&options, lower, d);
+        let enough = |lower| lower * (1.0 + options.rel_err);
+        let (tiny, grown) = (FINEST * d, FINEST * d * 4.0 / options.rel_err);
+        assert_eq!(floor(tiny), FLOOR * d);
+        let piece = FLOOR * d / 2.0;
+        let bound = grown * 1.01;
+        assert_eq!(
+            unpark(bound, piece, enough(tiny), floor(tiny)),
+            Unpark::Stays
+        );
+        assert!(floor(grown) < piece);
+        assert_eq!(
+            unpark(bound, piece, enough(grown), floor(grown)),
+            Unpark::Split
+        );
+        let allowed = enough(grown);
+        for within in [grown, allowed] {
+            assert_eq!(unpark(within, piece, allowed, floor(grown)), Unpark::Within);
+        }
+        assert_eq!(
+            unpark(bound, floor(grown), enough(grown), floor(grown)),
+            Unpark::Stays
+        );
     }
 
     /// The least of the planes at `l`, the function [`interpolated_envelope`] maximises.
