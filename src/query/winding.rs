@@ -955,6 +955,31 @@ mod tests {
         assert_eq!(bounded(0.1, 0.0)(10.0, 1.0, 0.0, 0.1), None);
     }
 
+    /// A triangle's solid angle does not change with scale, and far from the origin (where
+    /// the formula's cubes overflow) it is the unit-size angle to the bit: a power of two
+    /// scales exactly. Both ways to overflow: the numerator and the denominator together,
+    /// and the denominator alone (a triangle seen almost edge-on, its triple product tiny).
+    #[test]
+    fn solid_angles_are_the_same_far_from_the_origin() {
+        let v = Vector3::new;
+        let far = 2f64.powi(400);
+        for [a, b, c] in [
+            [v(1.0, 0.2, 0.5), v(-0.3, 1.0, 0.4), v(0.1, -0.6, 0.9)],
+            [v(0.5, -1.0, -2.0), v(0.25, 1.0, -1.5), v(-1.0, 0.0, -0.75)],
+            [v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0), v(1.0, 1.0, 1e-60)],
+        ] {
+            let unit = solid_angle(&a, &b, &c);
+            assert!(unit != 0.0 && unit.is_finite(), "{unit}");
+            let (x, y) = ((a * far).dot(&(b * far).cross(&(c * far))), (a * far).norm());
+            assert!(!(x.is_finite() && (y * y * y).is_finite()), "no overflow at this scale");
+            assert_eq!(solid_angle(&(a * far), &(b * far), &(c * far)), unit);
+            // Seen from the other side: the sign changes, the size to rounding.
+            let flipped = solid_angle(&(b * far), &(a * far), &(c * far));
+            assert_eq!(flipped, solid_angle(&b, &a, &c));
+            assert!((flipped + unit).abs() <= 4.0 * f64::EPSILON * unit.abs());
+        }
+    }
+
     /// Where this CPU has FMA, batches take the fused descent: its answers are the separate
     /// one's up to rounding, with the same error bounds and work.
     #[test]
