@@ -231,7 +231,9 @@ fn bounded(
 ) -> impl Fn(f64, f64, f64, f64) -> Option<f64> + Sync + Send {
     let rate = tolerance / model_area;
     move |distance: f64, r: f64, area: f64, _| {
-        let error = area * r * r * r / (PI * (distance - r).powi(5));
+        // Ratios first: `A r³` and `(d − r)⁵` overflow for a model far smaller than one
+        // whose error does.
+        let error = area / (PI * (distance - r).powi(2)) * (r / (distance - r)).powi(3);
         (error <= rate * area).then_some(error)
     }
 }
@@ -242,7 +244,9 @@ fn bounded(
 fn barill(beta: f64) -> impl Fn(f64, f64, f64, f64) -> Option<f64> + Sync + Send {
     let bound = 1.0 / (PI * (1.0 - 1.0 / beta).powi(5));
     move |distance, r, area, inverse: f64| {
-        (distance > beta * r).then(|| bound * area * r * r * r * inverse.powi(5))
+        // `A / d²` and `(r / d)³`: the product `A r³` overflows, and `d⁻⁵` underflows, for
+        // models whose error is a finite number.
+        (distance > beta * r).then(|| bound * (area * inverse * inverse) * (r * inverse).powi(3))
     }
 }
 
@@ -970,13 +974,62 @@ mod tests {
         ] {
             let unit = solid_angle(&a, &b, &c);
             assert!(unit != 0.0 && unit.is_finite(), "{unit}");
-            let (x, y) = ((a * far).dot(&(b * far).cross(&(c * far))), (a * far).norm());
-            assert!(!(x.is_finite() && (y * y * y).is_finite()), "no overflow at this scale");
+            let (x, y) = (
+                (a * far).dot(&(b * far).cross(&(c * far))),
+                (a * far).norm(),
+            );
+            assert!(
+                !(x.is_finite() && (y * y * y).is_finite()),
+                "no overflow at this scale"
+            );
             assert_eq!(solid_angle(&(a * far), &(b * far), &(c * far)), unit);
             // Seen from the other side: the sign changes, the size to rounding.
             let flipped = solid_angle(&(b * far), &(a * far), &(c * far));
             assert_eq!(flipped, solid_angle(&b, &a, &c));
             assert!((flipped + unit).abs() <= 4.0 * f64::EPSILON * unit.abs());
+        }
+    }
+
+    /// A model so large that its large clusters' moments overflow (sums of fourth powers
+    /// of its size) while its triangles' areas do not (a few times larger and they would,
+    /// and no cluster could be placed) is still answered: such clusters are never taken as
+    /// far away but opened down to their triangles, whose exact angles are finite. Inside
+    /// and outside, at every accuracy.
+    #[test]
+    fn clusters_whose_moments_overflow_are_opened() {
+        let mesh = crate::generate::lat_long_sphere(1.0, 7, 9).expect("a sphere");
+        let options = BuildOptions {
+            scale: 1.5e77,
+            precision: crate::real::Precision::F64,
+            ..BuildOptions::default()
+        };
+        let huge = build(&mesh, &options, None).expect("builds");
+        let points = [[0.0; 3], [0.0, 0.2e77, 0.1e77], [4.5e77, 0.0, 0.0]];
+        let answer = |accuracy| {
+            let options = WindingOptions { accuracy };
+            winding_numbers_with(
+                &huge,
+                &Pose::identity(),
+                &points,
+                &options,
+                Arithmetic::Separate,
+            )
+            .expect("answers")
+        };
+        let exact = answer(WindingAccuracy::Exact);
+        for (w, inside) in exact.iter().zip([1.0, 1.0, 0.0]) {
+            assert!((w.value - inside).abs() < 1e-9, "{w:?}");
+        }
+        for accuracy in [
+            WindingAccuracy::Beta { beta: 2.0 },
+            WindingAccuracy::Bounded { tolerance: 1e-3 },
+        ] {
+            for (w, e) in answer(accuracy).iter().zip(&exact) {
+                assert!(
+                    (w.value - e.value).abs() <= w.error_bound + 1e-9,
+                    "{accuracy:?}: {w:?} against {e:?}"
+                );
+            }
         }
     }
 
