@@ -231,8 +231,8 @@ fn bounded(
 ) -> impl Fn(f64, f64, f64, f64) -> Option<f64> + Sync + Send {
     let rate = tolerance / model_area;
     move |distance: f64, r: f64, area: f64, _| {
-        // Ratios first: `A r³` and `(d − r)⁵` overflow for a model far smaller than one
-        // whose error does.
+        // `A / (d − r)²` and `(r / (d − r))³`: the products `A r³` and `(d − r)⁵` overflow
+        // for models whose error is a finite number.
         let error = area / (PI * (distance - r).powi(2)) * (r / (distance - r)).powi(3);
         (error <= rate * area).then_some(error)
     }
