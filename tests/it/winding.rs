@@ -347,7 +347,9 @@ fn the_cli_answers_as_the_library() {
 /// Far from a model, and on a model whose moments overflow, winding numbers stay finite
 /// in every mode: the expansion is evaluated on the unit direction (no power of the
 /// distance is formed), a triangle's exact angle is taken again at unit scale when its
-/// cubes overflow, and a cluster whose moments overflowed is opened.
+/// cubes overflow, and a cluster that cannot be placed (its area overflowed) is opened.
+/// (The window where only the moments overflow is the unit test
+/// `clusters_whose_moments_overflow_are_opened`.)
 #[test]
 fn far_points_and_huge_models_get_finite_winding_numbers() {
     let accuracies = [
@@ -371,7 +373,8 @@ fn far_points_and_huge_models_get_finite_winding_numbers() {
             );
         }
     }
-    // A sphere 1e80 across: its moments' fourth powers overflow, not its coordinates.
+    // A sphere 1e80 across: its triangles' areas (squares of squares of its size)
+    // overflow, not its coordinates, so every cluster is opened.
     let huge = obbtree::build::BuildOptions {
         precision: obbtree::real::Precision::F64,
         scale: 1e80,
