@@ -523,8 +523,10 @@ impl F32Pair {
         // module's 64u bound per unit of direction, and the division and root's 8u.
         let gap = gap - slack - 8.0 * U * gap.abs();
         let best = best.max(gap);
-        let short = gap + slack < CONVERGED * f64::from(length);
-        (best, short && best < enough)
+        (
+            best,
+            edges_could_add(gap, slack, f64::from(length), best, enough),
+        )
     }
 }
 
@@ -532,6 +534,16 @@ impl F32Pair {
 #[inline(always)]
 fn centre_offset<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose) -> Vector3<f64> {
     b_to_a.apply(&Vector3::from(b.center_f64())) - Vector3::from(a.center_f64())
+}
+
+/// Whether the f64 bound would go on to the edge-edge axes after the direction's `gap`
+/// (lowered by `slack`) between points `length` apart, as [`super::pair::BoxPair`]'s rule
+/// decides on the unlowered gap (short of `CONVERGED` of the points' distance), and the
+/// bound `best` so far is still short of `enough`. Either way the bound stays a lower
+/// bound: this only decides whether the edge axes are worth their cost.
+#[inline(always)]
+fn edges_could_add(gap: f64, slack: f64, length: f64, best: f64, enough: f64) -> bool {
+    gap + slack < CONVERGED * length && best < enough
 }
 
 /// A box's half-widths summed, in f64.
@@ -574,4 +586,27 @@ pub(crate) fn distance_lower_bound_until<R: Real>(
     let centres = (t0 * t0 + t1 * t1 + t2 * t2).sqrt();
     let (bound, edges) = pair.distance_lower_bound_until(enough);
     Some((bound, centres, edges))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The edge axes are computed where the unlowered gap is short of `CONVERGED` of the
+    /// points' distance (as in f64, exclusive at equality) and the bound short of `enough`
+    /// (exclusive too: a bound that reached it prunes already).
+    #[test]
+    fn edge_axes_only_where_the_unlowered_gap_is_short_and_the_bound_is_not_enough() {
+        // CONVERGED · 10 is 9 exactly; 8.5 + 0.5 too.
+        assert_eq!(CONVERGED * 10.0, 9.0);
+        // Short: the unlowered gap 8.9 < 9.
+        assert!(edges_could_add(8.4, 0.5, 10.0, 8.4, 100.0));
+        // At the threshold, and above it though the lowered gap alone is below.
+        assert!(!edges_could_add(8.5, 0.5, 10.0, 8.5, 100.0));
+        assert!(!edges_could_add(8.6, 0.5, 10.0, 8.6, 100.0));
+        // Short, but the bound reached `enough` (exactly, or past it).
+        assert!(!edges_could_add(8.4, 0.5, 10.0, 8.4, 8.4));
+        assert!(!edges_could_add(8.4, 0.5, 10.0, 8.4, 8.0));
+        assert!(edges_could_add(8.4, 0.5, 10.0, 8.4, 8.5));
+    }
 }
