@@ -86,21 +86,17 @@ impl<R: Real> Obb<R> {
     }
 
     /// The distance lower bound ([`BoxPair::distance_lower_bound_until`]) and the centres'
-    /// distance: for f32 boxes their face-axis and direction terms on the stored values
-    /// ([`super::pair_f32`]), the f64 bound where it would go on to the edge-edge axes or
-    /// re-orthonormalise the frames.
+    /// distance: for f32 boxes on the stored values ([`super::pair_f32`]), in f64 where
+    /// the bound would re-orthonormalise the frames.
     #[inline(always)]
     fn distance_bound(&self, other: &Self, b_to_a: &Pose, enough: f64) -> (f64, f64) {
         if R::PRECISION == Precision::F32 {
             let tol = axis_tolerance(R::PRECISION);
             let far = |offset_norm1, halves| frames_far_apart(tol, offset_norm1, halves);
-            match super::pair_f32::distance_lower_bound_until(self, other, b_to_a, enough, far) {
-                Some((bound, centres, false)) => return (bound, centres),
-                Some((bound, centres, true)) => {
-                    let pair = self.pair_with(other, b_to_a, PairSetup::Metric);
-                    return (bound.max(pair.distance_lower_bound_until(enough)), centres);
-                }
-                None => {}
+            if let Some(bound_and_centres) =
+                super::pair_f32::distance_lower_bound_until(self, other, b_to_a, enough, far)
+            {
+                return bound_and_centres;
             }
         }
         let pair = self.pair_with(other, b_to_a, PairSetup::Metric);

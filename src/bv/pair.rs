@@ -232,8 +232,8 @@ impl BoxPair {
         self.distance_lower_bound_until(f64::INFINITY)
     }
 
-    /// A lower bound on the distance between the boxes, the larger of two terms, in order
-    /// of cost, stopping after the first if it reaches `enough`:
+    /// A lower bound on the distance between the boxes, the largest of three terms, in
+    /// order of cost, stopping once one reaches `enough`:
     ///
     /// - the gaps between their projections on the 6 face axes (tight for boxes side by
     ///   side; B's three prune little between mesh pairs, but between concentric
@@ -241,12 +241,13 @@ impl BoxPair {
     /// - the gap on the direction between nearly closest points
     ///   ([`BoxPair::closest_direction_gap`]), near the box distance wherever the axis gaps
     ///   fall short of it: up to a factor √3 for boxes diagonal to each other, and without
-    ///   limit for boxes far apart relative to their size.
+    ///   limit for boxes far apart relative to their size;
+    /// - where the second falls short of the distance of the points it was taken between
+    ///   (by more than [`CONVERGED`] allows), the gaps on the 9 edge-edge axes
+    ///   ([`BoxPair::edge_axis_gap`]).
     ///
     /// Each is lowered by the frame [`BoxPair::slack`], as `disjoint` raises its radii by
-    /// it. 0 if the boxes may touch. (The 9 edge-edge axes of the separating-axis test and
-    /// the centre-to-box bounds were terms here too: after the second term they pruned
-    /// nothing on the bunny and cost a large share of a distance query.)
+    /// it. 0 if the boxes may touch.
     #[inline(always)]
     // why: as in `disjoint`, entries indexed by axis numbers in 0..3.
     #[allow(clippy::indexing_slicing)]

@@ -99,6 +99,14 @@ mod lanes {
         unsafe { _mm_mul_ps(a, b) }
     }
     #[inline(always)]
+    pub fn div(a: V, b: V) -> V {
+        unsafe { _mm_div_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn sqrt(a: V) -> V {
+        unsafe { _mm_sqrt_ps(a) }
+    }
+    #[inline(always)]
     pub fn abs(a: V) -> V {
         unsafe { _mm_andnot_ps(_mm_set1_ps(-0.0), a) }
     }
@@ -188,6 +196,15 @@ mod lanes {
         zip(a, b, |x, y| x * y)
     }
     #[inline(always)]
+    pub fn div(a: V, b: V) -> V {
+        zip(a, b, |x, y| x / y)
+    }
+    #[inline(always)]
+    pub fn sqrt(a: V) -> V {
+        let [x, y, z, w] = a;
+        [x.sqrt(), y.sqrt(), z.sqrt(), w.sqrt()]
+    }
+    #[inline(always)]
     pub fn abs(a: V) -> V {
         let [x, y, z, w] = a;
         [x.abs(), y.abs(), z.abs(), w.abs()]
@@ -251,6 +268,14 @@ impl F4 {
     #[inline(always)]
     fn mul_add(self, a: F4, b: F4) -> F4 {
         self.add(a.mul(b))
+    }
+    #[inline(always)]
+    fn div(self, o: F4) -> F4 {
+        F4(lanes::div(self.0, o.0))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> F4 {
+        F4(lanes::sqrt(self.0))
     }
     #[inline(always)]
     fn abs(self) -> F4 {
@@ -339,25 +364,60 @@ fn combine(s: F4, rows: &[F4; 3]) -> F4 {
         .mul_add(r2, s.lane2())
 }
 
-/// One edge-axis family of the separating-axis test, the three `a_i × b_j` of one `i` at
-/// once: `|t_i2 m_i1j − t_i1 m_i2j| > ha_i1 |m_i2j| + ha_i2 |m_i1j| + hb_j1 |m_ij2| +
-/// hb_j2 |m_ij1| + slack` for some `j`, where `(i1, i2)` follow `i` cyclically. The
-/// arguments are rows `i1` and `i2` of `m`, rows `i`, `i1`, `i2` of the guarded `|m|`, and
-/// the scalars splatted.
+/// One edge-axis family of the separating-axis test, the three axes `a_i × b_j` of one `i`
+/// at once: the projection of the centre offset, `|t_i2 m_i1j − t_i1 m_i2j|`, and the sum
+/// of the boxes' radii, `ha_i1 |m_i2j| + ha_i2 |m_i1j| + hb_j1 |m_ij2| + hb_j2 |m_ij1|`, both
+/// scaled by the axis length, where `(i1, i2)` follow `i` cyclically. The arguments are the
+/// family's `i` (rows `i1` and `i2` of `m`, rows `i`, `i1`, `i2` of the guarded `|m|`, and
+/// the scalars splatted) and B's half-widths.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn edge_separates(
-    (m_i1, m_i2): (F4, F4),
-    (abs_i, abs_i1, abs_i2): (F4, F4, F4),
-    (t_i1, t_i2): (F4, F4),
-    (ha_i1, ha_i2): (F4, F4),
-    hb: F4,
-    slack: F4,
-) -> bool {
+fn edge_terms(family: &EdgeFamily, hb: F4) -> (F4, F4) {
+    let (m_i1, m_i2) = family.m;
+    let (abs_i, abs_i1, abs_i2) = family.abs;
+    let (t_i1, t_i2) = family.t;
+    let (ha_i1, ha_i2) = family.ha;
     let tl = m_i1.mul(t_i2).sub(m_i2.mul(t_i1)).abs();
     let ra = abs_i2.mul(ha_i1).mul_add(abs_i1, ha_i2);
     let rb = hb.rot1().mul(abs_i.rot2()).mul_add(hb.rot2(), abs_i.rot1());
-    tl.any_gt(ra.add(rb).add(slack))
+    (tl, ra.add(rb))
+}
+
+/// What [`edge_terms`] reads of one family `i` of edge axes (see there).
+struct EdgeFamily {
+    m: (F4, F4),
+    abs: (F4, F4, F4),
+    t: (F4, F4),
+    ha: (F4, F4),
+}
+
+/// The three edge-axis families of two boxes (`m`, `t`, `ha` as in [`F32Pair`], `abs_m`
+/// the guarded `|m|`), in the order `i` = 0, 1, 2.
+#[inline(always)]
+fn edge_families(m: [F4; 3], abs_m: [F4; 3], t: F4, ha: F4) -> [EdgeFamily; 3] {
+    let (tx, ty, tz) = (t.lane0(), t.lane1(), t.lane2());
+    let (hx, hy, hz) = (ha.lane0(), ha.lane1(), ha.lane2());
+    let [m0, m1, m2] = m;
+    let [abs0, abs1, abs2] = abs_m;
+    [
+        EdgeFamily {
+            m: (m1, m2),
+            abs: (abs0, abs1, abs2),
+            t: (ty, tz),
+            ha: (hy, hz),
+        },
+        EdgeFamily {
+            m: (m2, m0),
+            abs: (abs1, abs2, abs0),
+            t: (tz, tx),
+            ha: (hz, hx),
+        },
+        EdgeFamily {
+            m: (m0, m1),
+            abs: (abs2, abs0, abs1),
+            t: (tx, ty),
+            ha: (hx, hy),
+        },
+    ]
 }
 
 /// A box's axes as three rows and its half-widths, each loaded as four values: the three
@@ -469,26 +529,24 @@ impl F32Pair {
         if tb.any_gt(ra.add(hb).add(slack)) {
             return true;
         }
-        // Edge axes a_i × b_j, the three j of one i at once:
-        // |t_i2 m_i1j − t_i1 m_i2j| > ha_i1 |m_i2j| + ha_i2 |m_i1j| + hb_j1 |m_ij2| + hb_j2 |m_ij1|.
-        let (tx, ty, tz) = (t.lane0(), t.lane1(), t.lane2());
-        let (hx, hy, hz) = (ha.lane0(), ha.lane1(), ha.lane2());
-        let [m0, m1, m2] = m;
-        let [abs0, abs1, abs2] = abs_m;
-        edge_separates((m1, m2), (abs0, abs1, abs2), (ty, tz), (hy, hz), hb, slack)
-            || edge_separates((m2, m0), (abs1, abs2, abs0), (tz, tx), (hz, hx), hb, slack)
-            || edge_separates((m0, m1), (abs2, abs0, abs1), (tx, ty), (hx, hy), hb, slack)
+        // Edge axes a_i × b_j, the three j of one i at once: the offset's projection
+        // beyond the radii and the slack.
+        let separates = |family: &EdgeFamily| {
+            let (projection, radii) = edge_terms(family, hb);
+            projection.any_gt(radii.add(slack))
+        };
+        let [i0, i1, i2] = edge_families(m, abs_m, t, ha);
+        separates(&i0) || separates(&i1) || separates(&i2)
     }
 
-    /// The first two terms of [`super::pair::BoxPair::distance_lower_bound_until`] in f32:
-    /// the face-axis gaps and, unless they reach `enough`, the gap along the direction of
-    /// the alternating projections' points. Each less the f64 slack and the f32 rounding
-    /// bound (for the direction's gap, also 8u of itself: its division and square root),
-    /// so a lower bound on the box distance. Also says whether the edge-edge axes could
-    /// still add to it (as the f64 bound decides: the direction's gap short of the points'
-    /// distance).
+    /// [`super::pair::BoxPair::distance_lower_bound_until`] in f32: the face-axis gaps;
+    /// unless they reach `enough`, the gap along the direction of the alternating
+    /// projections' points; and where that falls short of the points' distance (as the f64
+    /// bound decides), the edge-edge axes' gaps. Each less the f64 slack and the f32
+    /// rounding bound (for the gaps divided by a length, also 8u of themselves: the
+    /// division and square root), so a lower bound on the box distance.
     #[inline(always)]
-    fn distance_lower_bound_until(&self, enough: f64) -> (f64, bool) {
+    fn distance_lower_bound_until(&self, enough: f64) -> f64 {
         let (m, t, ha, hb) = (self.m, self.t, self.ha, self.hb);
         let slack = self.slack(SAT_GUARD);
         // The entries' error, as the overlap test's guard covers it (no §4.5 guard here,
@@ -500,7 +558,7 @@ impl F32Pair {
         let best = f64::from(face_a.max(face_b).max_lane()) - slack;
         let best = best.max(0.0);
         if best >= enough {
-            return (best, false);
+            return best;
         }
         // Alternating projections: B's centre clamped into A, the point of B nearest it,
         // that clamped into A (PROJECTION_STEPS = 1 of the f64 bound).
@@ -514,7 +572,7 @@ impl F32Pair {
         // (Points that meet, or NaN from a damaged file: no direction, and, as in f64,
         // nothing more to try.)
         if !(length2 > 0.0 && length2.is_finite()) {
-            return (best, false);
+            return best;
         }
         let length = length2.sqrt();
         let numerator = d.dot(t) - ha.dot(d.abs()) - hb.dot(combine(d, &m).abs());
@@ -523,10 +581,44 @@ impl F32Pair {
         // module's 64u bound per unit of direction, and the division and root's 8u.
         let gap = gap - slack - 8.0 * U * gap.abs();
         let best = best.max(gap);
-        (
-            best,
-            edges_could_add(gap, slack, f64::from(length), best, enough),
-        )
+        if edges_could_add(gap, slack, f64::from(length), best, enough) {
+            best.max(self.edge_axis_gap(abs_m, slack))
+        } else {
+            best
+        }
+    }
+
+    /// The largest gap on the 9 edge-edge axes `a_i × b_j`
+    /// ([`super::pair::BoxPair::edge_axis_gap`]), less `slack`, or 0: each axis's
+    /// projected gap (off by at most the module's `64u·(|t|₁ + Σ half-widths)`, in
+    /// `slack`) divided by an upper bound on the axis length. That length, `|(m_i1j,
+    /// m_i2j)|` (B's axis `j`, column `j` of `m`, across A's axis `i`), is off by at most 23u
+    /// through `m`'s entries and 3u of itself through its rounding. No axis is skipped: a
+    /// nearly parallel pair of edges gets a length of at least the error's bound, so a
+    /// gap no larger than the offset over that bound.
+    ///
+    /// So an edge gap loses about `64u·(|t|₁ + Σ half-widths)` over the axis length
+    /// against the f64 bound's: tight across edges that cross at large angles, looser
+    /// for nearly parallel ones, where the face axes bound the boxes about as well.
+    // Not inlined: few pairs get here, and inlined into the traversal it changed the code
+    // generated for the collision queries too (more instructions there).
+    #[inline(never)]
+    fn edge_axis_gap(&self, abs_m: [F4; 3], slack: f64) -> f64 {
+        let length_error = F4::splat(up(32.0 * U));
+        let slack = F4::splat(up(slack));
+        let gaps = edge_families(self.m, abs_m, self.t, self.ha)
+            .iter()
+            .map(|family| {
+                let (projection, radii) = edge_terms(family, self.hb);
+                let (m_i1, m_i2) = family.m;
+                let length = m_i1.mul(m_i1).add(m_i2.mul(m_i2)).sqrt().add(length_error);
+                projection.sub(radii).sub(slack).div(length)
+            })
+            .fold(F4::splat(0.0), F4::max);
+        // The division, the root and the sums in and under it: 8u of the gap. (Lane 3 is
+        // 0 / 0, which the largest lane does not read.)
+        let gap = f64::from(gaps.max_lane());
+        (gap - 8.0 * U * gap.abs()).max(0.0)
     }
 }
 
@@ -562,12 +654,10 @@ pub(crate) fn disjoint<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose, guard: Gu
 }
 
 /// A lower bound on the distance between two f32 boxes (B posed in A's model frame by
-/// `b_to_a`) and the distance of their centres: the face-axis and direction terms of the
-/// f64 bound in f32, with their rounding taken off, stopping once the bound reaches
-/// `enough`. `None` where the f64 bound would re-orthonormalise the frames (boxes far
-/// apart relative to their size, `far(|offset|₁, Σ half-widths)`), and a third value
-/// `true` where the f64 bound would go on to the edge-edge axes: the caller then computes
-/// it.
+/// `b_to_a`) and the distance of their centres: the terms of the f64 bound in f32, with
+/// their rounding taken off, stopping once the bound reaches `enough`. `None` where the
+/// f64 bound would re-orthonormalise the frames (boxes far apart relative to their size,
+/// `far(|offset|₁, Σ half-widths)`): the caller then computes it.
 #[inline(always)]
 pub(crate) fn distance_lower_bound_until<R: Real>(
     a: &Obb<R>,
@@ -575,7 +665,7 @@ pub(crate) fn distance_lower_bound_until<R: Real>(
     b_to_a: &Pose,
     enough: f64,
     far: impl Fn(f64, f64) -> bool,
-) -> Option<(f64, f64, bool)> {
+) -> Option<(f64, f64)> {
     // Checked before anything is computed in f32: past it the caller computes in f64.
     let offset = centre_offset(a, b, b_to_a);
     if far(offset.abs().sum(), half_sum(a) + half_sum(b)) {
@@ -584,8 +674,7 @@ pub(crate) fn distance_lower_bound_until<R: Real>(
     let pair = F32Pair::with_offset(a, b, b_to_a, &offset);
     let [t0, t1, t2] = pair.t64;
     let centres = (t0 * t0 + t1 * t1 + t2 * t2).sqrt();
-    let (bound, edges) = pair.distance_lower_bound_until(enough);
-    Some((bound, centres, edges))
+    Some((pair.distance_lower_bound_until(enough), centres))
 }
 
 #[cfg(test)]
@@ -608,5 +697,85 @@ mod tests {
         assert!(!edges_could_add(8.4, 0.5, 10.0, 8.4, 8.4));
         assert!(!edges_could_add(8.4, 0.5, 10.0, 8.4, 8.0));
         assert!(edges_could_add(8.4, 0.5, 10.0, 8.4, 8.5));
+    }
+
+    /// A stick: a box of f32 frame `axes` (rows) and half-widths (1, 0, 0) at `center`.
+    fn stick(axes: [[f64; 3]; 3], center: [f64; 3]) -> Obb<f32> {
+        Obb {
+            axes: axes.map(|row| row.map(|v| v as f32)),
+            center: center.map(|v| v as f32),
+            half: [1.0, 0.0, 0.0],
+        }
+    }
+
+    /// Two sticks on skew lines `h` apart, crossing at 10°, B's centre off the closest
+    /// points along its line, both frames turned about the sticks: no face axis is the
+    /// common perpendicular and one alternating projection falls short, so the edge axis
+    /// `a₀ × b₀` carries the bound, which comes within the slacks of `h` and stays below
+    /// it.
+    #[test]
+    fn the_edge_axes_bound_crossing_sticks_by_their_distance() {
+        let h = 0.25;
+        let (s10, c10) = 10f64.to_radians().sin_cos();
+        let (s30, c30) = 30f64.to_radians().sin_cos();
+        let a = stick(
+            [[1.0, 0.0, 0.0], [0.0, c30, s30], [0.0, -s30, c30]],
+            [0.0; 3],
+        );
+        // B along v = (cos 10°, sin 10°, 0); its other axes z and v × z, turned 30° about v.
+        let (v, w1, w2) = ([c10, s10, 0.0], [0.0, 0.0, 1.0], [s10, -c10, 0.0]);
+        let turn =
+            |p: f64, q: f64| crate::arr3::map(crate::arr3::zip(w1, w2), |(x, y)| p * x + q * y);
+        let b = stick(
+            [v, turn(c30, s30), turn(-s30, c30)],
+            [0.4 * c10, 0.4 * s10, h],
+        );
+        let here = Pose::identity();
+        let pair = F32Pair::new(&a, &b, &here);
+        let bound = pair.distance_lower_bound_until(f64::INFINITY);
+        // Below h by the slacks divided by the axis length, sin 10°.
+        assert!(bound <= h && bound > h - 2e-4, "{bound}");
+        // The terms before the edge axes are short of it.
+        let f64_pair = super::super::pair::BoxPair::new(
+            &a.axes_matrix(),
+            &Vector3::from(a.center_f64()),
+            Vector3::from(a.half_f64()),
+            &b.axes_matrix(),
+            &Vector3::from(b.center_f64()),
+            Vector3::from(b.half_f64()),
+            &here,
+            super::super::obb::axis_tolerance(crate::real::Precision::F32),
+        );
+        let (direction_gap, apart) = f64_pair.closest_direction_gap();
+        assert!(direction_gap < CONVERGED * apart && direction_gap < 0.9 * h);
+        let (m, t) = (f64_pair.m, f64_pair.t);
+        let faces = (0..3).map(|i| {
+            let along_a = t[i].abs() - (m.row(i).abs() * f64_pair.hb)[0] - f64_pair.ha[i];
+            let along_b = (m.column(i).dot(&t)).abs() - f64_pair.ha.dot(&m.column(i).abs());
+            along_a.max(along_b - f64_pair.hb[i])
+        });
+        assert!(faces.fold(0.0, f64::max) < 0.9 * h);
+    }
+
+    /// Two sticks along x, B turned by 1e-8 about z and 1000 above A: the edge axis
+    /// `a₀ × b₀` is of length about 1e-8, within the rounding of `m`, and would make any
+    /// gap on it huge. Its length's upper bound keeps the bound below the distance.
+    #[test]
+    fn nearly_parallel_edges_keep_the_bound_below_the_distance() {
+        let (s, c) = 1e-8f64.sin_cos();
+        let a = stick(
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            [0.0; 3],
+        );
+        let b = stick(
+            [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]],
+            [0.0, 0.0, 1000.0],
+        );
+        let pair = F32Pair::new(&a, &b, &Pose::identity());
+        let abs_m = pair.m.map(|row| row.abs());
+        let edges = pair.edge_axis_gap(abs_m, pair.slack(SAT_GUARD));
+        assert!(edges.is_finite() && edges <= 1000.0, "{edges}");
+        let bound = pair.distance_lower_bound_until(f64::INFINITY);
+        assert!(bound <= 1000.0 && bound > 999.99, "{bound}");
     }
 }
