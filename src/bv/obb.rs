@@ -87,7 +87,7 @@ impl<R: Real> Obb<R> {
 
     /// The distance lower bound ([`BoxPair::distance_lower_bound_until`]) and the centres'
     /// distance: for f32 boxes on the stored values ([`super::pair_f32`]), in f64 where
-    /// the bound would re-orthonormalise the frames.
+    /// the bound would re-orthonormalise the frames or the pair is beyond f32's range.
     #[inline(always)]
     fn distance_bound(&self, other: &Self, b_to_a: &Pose, enough: f64) -> (f64, f64) {
         if R::PRECISION == Precision::F32 {

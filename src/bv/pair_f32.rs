@@ -511,7 +511,8 @@ impl F32Pair {
 
     /// Whether the boxes are certainly disjoint, by the 15 separating axes, with `guard` as
     /// in [`super::pair::BoxPair::disjoint`]: `true` only where that test also reports
-    /// them disjoint, up to the rounding bounds of the module documentation.
+    /// them disjoint, up to the rounding bounds of the module documentation (which hold
+    /// where the pair is [`within_f32_range`]: docs/LIMITATIONS.md says where not).
     #[inline(always)]
     fn disjoint(&self, guard: Guard) -> bool {
         let (m, t, ha, hb) = (self.m, self.t, self.ha, self.hb);
@@ -592,10 +593,11 @@ impl F32Pair {
     /// ([`super::pair::BoxPair::edge_axis_gap`]), less `slack`, or 0: each axis's
     /// projected gap (off by at most the module's `64u·(|t|₁ + Σ half-widths)`, in
     /// `slack`) divided by an upper bound on the axis length. That length, `|(m_i1j,
-    /// m_i2j)|` (B's axis `j`, column `j` of `m`, across A's axis `i`), is off by at most 23u
-    /// through `m`'s entries and 3u of itself through its rounding. No axis is skipped: a
-    /// nearly parallel pair of edges gets a length of at least the error's bound, so a
-    /// gap no larger than the offset over that bound.
+    /// m_i2j)|` (B's axis `j`, column `j` of `m`, across A's axis `i`: the exact length of
+    /// that cross product in A's frame), is off by at most 23u through `m`'s entries and
+    /// about 3u through its own rounding, both inside the 32u added. No axis needs
+    /// skipping: a gap is positive only on an axis longer than the slack's share of the
+    /// offset (about 8e-6), far above that error.
     ///
     /// So an edge gap loses about `64u·(|t|₁ + Σ half-widths)` over the axis length
     /// against the f64 bound's: tight across edges that cross at large angles, looser
@@ -615,8 +617,8 @@ impl F32Pair {
                 projection.sub(radii).sub(slack).div(length)
             })
             .fold(F4::splat(0.0), F4::max);
-        // The division, the root and the sums in and under it: 8u of the gap. (Lane 3 is
-        // 0 / 0, which the largest lane does not read.)
+        // The division's rounding and the slack's subtraction: within 8u of the gap.
+        // (Lane 3 is 0 / 0, which the largest lane does not read.)
         let gap = f64::from(gaps.max_lane());
         (gap - 8.0 * U * gap.abs()).max(0.0)
     }
@@ -644,6 +646,18 @@ fn half_sum<R: Real>(o: &Obb<R>) -> f64 {
     o.half_f64().iter().sum()
 }
 
+/// Whether the module's rounding bounds hold for a pair whose centre offset (1-norm) and
+/// half-widths sum to `scale`: f32's relative rounding needs the few-term sums of the
+/// tests below its largest number, and the slack, proportional to `scale`, far above the
+/// absolute error of products that underflow. Outside (models about 1e36 across or posed
+/// as far out, and below 1e-30; or a NaN) the distance bound hands the pair to f64; the
+/// overlap test does not check, since a check there costs every collision query
+/// measurably (docs/LIMITATIONS.md).
+#[inline(always)]
+fn within_f32_range(scale: f64) -> bool {
+    (1e-30..=1e36).contains(&scale)
+}
+
 /// Whether two f32 boxes are certainly disjoint (B posed in A's model frame by `b_to_a`),
 /// by the 15 separating axes, with `guard` as in [`super::pair::BoxPair::disjoint`]:
 /// `true` only where that test also reports them disjoint, up to the rounding bounds of
@@ -657,7 +671,8 @@ pub(crate) fn disjoint<R: Real>(a: &Obb<R>, b: &Obb<R>, b_to_a: &Pose, guard: Gu
 /// `b_to_a`) and the distance of their centres: the terms of the f64 bound in f32, with
 /// their rounding taken off, stopping once the bound reaches `enough`. `None` where the
 /// f64 bound would re-orthonormalise the frames (boxes far apart relative to their size,
-/// `far(|offset|₁, Σ half-widths)`): the caller then computes it.
+/// `far(|offset|₁, Σ half-widths)`) and outside [`within_f32_range`]: the caller then
+/// computes it.
 #[inline(always)]
 pub(crate) fn distance_lower_bound_until<R: Real>(
     a: &Obb<R>,
@@ -668,7 +683,8 @@ pub(crate) fn distance_lower_bound_until<R: Real>(
 ) -> Option<(f64, f64)> {
     // Checked before anything is computed in f32: past it the caller computes in f64.
     let offset = centre_offset(a, b, b_to_a);
-    if far(offset.abs().sum(), half_sum(a) + half_sum(b)) {
+    let (offset_norm1, halves) = (offset.abs().sum(), half_sum(a) + half_sum(b));
+    if far(offset_norm1, halves) || !within_f32_range(offset_norm1 + halves) {
         return None;
     }
     let pair = F32Pair::with_offset(a, b, b_to_a, &offset);
@@ -697,6 +713,12 @@ mod tests {
         assert!(!edges_could_add(8.4, 0.5, 10.0, 8.4, 8.4));
         assert!(!edges_could_add(8.4, 0.5, 10.0, 8.4, 8.0));
         assert!(edges_could_add(8.4, 0.5, 10.0, 8.4, 8.5));
+    }
+
+    /// `|m|` with the rounding guard the distance bound adds.
+    fn guarded_abs(pair: &F32Pair) -> [F4; 3] {
+        let g = F4::splat(up(17.0 * U));
+        pair.m.map(|row| row.abs().add(g))
     }
 
     /// A stick: a box of f32 frame `axes` (rows) and half-widths (1, 0, 0) at `center`.
@@ -732,9 +754,12 @@ mod tests {
         );
         let here = Pose::identity();
         let pair = F32Pair::new(&a, &b, &here);
+        // The edge gaps, and the bound they carry: below h by the slacks divided by the
+        // axis length, sin 10°.
+        let edges = pair.edge_axis_gap(guarded_abs(&pair), pair.slack(SAT_GUARD));
+        assert!(edges <= h && edges > h - 2e-4, "{edges}");
         let bound = pair.distance_lower_bound_until(f64::INFINITY);
-        // Below h by the slacks divided by the axis length, sin 10°.
-        assert!(bound <= h && bound > h - 2e-4, "{bound}");
+        assert_eq!(bound, edges);
         // The terms before the edge axes are short of it.
         let f64_pair = super::super::pair::BoxPair::new(
             &a.axes_matrix(),
@@ -758,8 +783,9 @@ mod tests {
     }
 
     /// Two sticks along x, B turned by 1e-8 about z and 1000 above A: the edge axis
-    /// `a₀ × b₀` is of length about 1e-8, within the rounding of `m`, and would make any
-    /// gap on it huge. Its length's upper bound keeps the bound below the distance.
+    /// `a₀ × b₀` is of length about 1e-8, within the rounding of `m`. The edge gaps stay
+    /// finite and below the distance, and the bound, from the other axes, within 0.01 of
+    /// it.
     #[test]
     fn nearly_parallel_edges_keep_the_bound_below_the_distance() {
         let (s, c) = 1e-8f64.sin_cos();
@@ -772,8 +798,7 @@ mod tests {
             [0.0, 0.0, 1000.0],
         );
         let pair = F32Pair::new(&a, &b, &Pose::identity());
-        let abs_m = pair.m.map(|row| row.abs());
-        let edges = pair.edge_axis_gap(abs_m, pair.slack(SAT_GUARD));
+        let edges = pair.edge_axis_gap(guarded_abs(&pair), pair.slack(SAT_GUARD));
         assert!(edges.is_finite() && edges <= 1000.0, "{edges}");
         let bound = pair.distance_lower_bound_until(f64::INFINITY);
         assert!(bound <= 1000.0 && bound > 999.99, "{bound}");

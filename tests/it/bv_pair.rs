@@ -385,6 +385,36 @@ proptest! {
     }
 }
 
+/// The f32 distance bound at the ends of f32's range, where its rounding bounds fail and
+/// the f64 bound answers: boxes about 3e38 across, overlapping where the offset between
+/// their centres (3.5e38) rounds to infinity in f32, have a bound of 0; sticks about
+/// 1e-44 long, their numbers subnormal in f32, get a bound below their distance.
+#[test]
+fn f32_distance_bounds_beyond_f32_s_range_stay_below_the_distance() {
+    let unit = [[1.0f32, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let huge = Obb::<f32> {
+        axes: unit,
+        center: [0.0; 3],
+        half: [3e38, 1.0, 1.0],
+    };
+    let there = Pose::translation(3.5e38, 0.0, 0.0);
+    assert_eq!(huge.distance_lower_bound(&huge, &there), 0.0);
+    // Two sticks along x, eight of the least f32 long, three quarters of that one apart
+    // along z: the distance is below anything f32 holds.
+    let least = f64::from(f32::from_bits(1));
+    let stick = Obb::<f32> {
+        axes: unit,
+        center: [0.0; 3],
+        half: [f32::from_bits(8), 0.0, 0.0],
+    };
+    let distance = 0.75 * least;
+    let bound = stick.distance_lower_bound(&stick, &Pose::translation(0.0, 0.0, distance));
+    assert!(
+        bound <= distance,
+        "bound {bound} above the distance {distance}"
+    );
+}
+
 #[test]
 fn separated_axis_aligned_boxes_have_the_exact_gap_as_lower_bound() {
     let a = obb(
