@@ -243,8 +243,8 @@ impl BoxPair {
     ///   fall short of it: up to a factor √3 for boxes diagonal to each other, and without
     ///   limit for boxes far apart relative to their size;
     /// - where the second falls short of the distance of the points it was taken between
-    ///   (by more than [`CONVERGED`] allows), the gaps on the 9 edge-edge axes
-    ///   ([`BoxPair::edge_axis_gap`]).
+    ///   by more than a tenth, the gaps on the 9 edge-edge axes, each divided by the axis
+    ///   length.
     ///
     /// Each is lowered by the frame [`BoxPair::slack`], as `disjoint` raises its radii by
     /// it. 0 if the boxes may touch.
