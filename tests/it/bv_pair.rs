@@ -399,8 +399,8 @@ fn f32_distance_bounds_beyond_f32_s_range_stay_below_the_distance() {
     };
     let there = Pose::translation(3.5e38, 0.0, 0.0);
     assert_eq!(huge.distance_lower_bound(&huge, &there), 0.0);
-    // Two sticks along x, eight of the least f32 long, three quarters of that one apart
-    // along z: the distance is below anything f32 holds.
+    // Two sticks along x, each of half-length eight times the least f32, three quarters
+    // of that least f32 apart along z: a distance below anything f32 holds.
     let least = f64::from(f32::from_bits(1));
     let stick = Obb::<f32> {
         axes: unit,
