@@ -290,8 +290,10 @@ impl BoxPair {
         for i in 0..3 {
             let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
             for j in 0..3 {
-                // |a_i x b_j| = sqrt(1 - m_ij^2) for unit axes.
-                let len2 = 1.0 - m[(i, j)] * m[(i, j)];
+                // |a_i x b_j| from the two entries it is made of: `1 - m_ij^2` is the same
+                // for orthonormal frames, but cancels for nearly parallel edges, where a pose
+                // orthonormal only within its tolerance makes it far too short.
+                let len2 = m[(i1, j)] * m[(i1, j)] + m[(i2, j)] * m[(i2, j)];
                 if len2 < 1e-12 {
                     continue;
                 }

@@ -306,6 +306,37 @@ proptest! {
         prop_assert!(lb32 >= lb64 - allowance, "f32 bound {lb32} far below the f64 bound {lb64}");
     }
 
+    /// Nearly parallel sticks under a pose whose rotation is orthonormal only within the
+    /// tolerance `Pose::new` accepts (scaled by up to 1 ± 4.9e-7): the bound's edge-edge
+    /// axes are then nearly zero vectors whose length must come from their own entries,
+    /// not from `1 − m_ij²` (which cancelled and made the bound up to 15 times the
+    /// distance).
+    #[test]
+    fn box_lower_bound_holds_for_nearly_parallel_sticks_under_a_pose_at_the_tolerance(
+        frame in prop::array::uniform3(-3.0..3.0f64),
+        widths in prop::array::uniform4(0.0..1e-3f64),
+        turn in (-4.0..-1.0f64, 0.0..6.3f64),
+        scale in -4.9e-7..4.9e-7f64,
+        along in -2.0..2.0f64,
+        across in prop::array::uniform2(-0.05..0.05f64),
+    ) {
+        let r = rotation(frame[0], frame[1], frame[2]);
+        let (x, y, z) = (r * Vector3::x(), r * Vector3::y(), r * Vector3::z());
+        let a = obb(r, Vector3::zeros(), Vector3::new(1.0, widths[0], widths[1]));
+        let b = obb(r, Vector3::zeros(), Vector3::new(1.0, widths[2], widths[3]));
+        let (angle, phi) = (10f64.powf(turn.0), turn.1);
+        let axis = nalgebra::Unit::new_normalize(y * phi.cos() + z * phi.sin());
+        let rotation = *Rotation3::from_axis_angle(&axis, angle).matrix() * (1.0 + scale);
+        let pose = Pose::new(rotation, x * along + y * across[0] + z * across[1]).unwrap();
+        let d = surface_distance(&a, &b, &pose);
+        let lb = a.distance_lower_bound(&b, &pose);
+        prop_assert!(lb <= d * (1.0 + 1e-9) + 1e-12, "f64 bound {lb} above the distance {d}");
+        let (a32, b32) = (stored_f32(&a, 0.0, 3), stored_f32(&b, 0.0, 3));
+        let d32 = surface_distance(&widened(&a32), &widened(&b32), &pose);
+        let lb32 = a32.distance_lower_bound(&b32, &pose);
+        prop_assert!(lb32 <= d32 * (1.0 + 1e-9) + 1e-12, "f32 bound {lb32} above the distance {d32}");
+    }
+
     #[test]
     fn overlap_is_never_missed(a in arb_box(), b in arb_box(), b_to_a in arb_relative_pose()) {
         // If some point of B lies inside A, the boxes overlap and the test must say so.

@@ -285,6 +285,41 @@ fn guard_case_without_the_guard_loses_real_contacts() {
     }
 }
 
+/// Two sticks (half-widths 1, 5e-4, 5e-4) nearly parallel, 0.004 rad apart, and B's pose
+/// a rotation scaled by 1 + 4.5e-7: orthonormal within 9e-7, which `Pose::new` accepts.
+/// The closest features are long edges, so the distance bound goes to the edge-edge axes,
+/// each almost the zero vector. An axis length of `√(1 − m_ij²)` cancels there: the
+/// scaled pose made it about half the true length, the bound of the sticks' boxes came out
+/// 16% above their distance, and the exact distance was 0.0409 instead of 0.0353.
+#[test]
+fn nearly_parallel_sticks_under_a_pose_at_the_orthonormality_tolerance() {
+    let stick = common::cuboid([1.0, 5e-4, 5e-4], [0.0; 3]);
+    let (s, c) = 1.2f64.sin_cos();
+    let turn = rotation_about([0.0, c, s], 0.004) * (1.0 + 4.5e-7);
+    let mut context = QueryContext::new();
+    for options in common::all_options() {
+        let file = built(&stick, &options);
+        let ta = world_triangles(&stick, options.precision, &Pose::identity());
+        let mut pair = PairQuery::with_context(&file, &file, std::mem::take(&mut context)).unwrap();
+        for x in [-1.5, -0.5, 0.0, 0.5, 1.0] {
+            for y in [-0.04, 0.04] {
+                let pose_b = pose(turn, [x, y, 0.0]);
+                let reference =
+                    oracle::min_distance(&ta, &world_triangles(&stick, options.precision, &pose_b));
+                let d = pair
+                    .distance(&Pose::identity(), &pose_b, &DistanceOptions::default())
+                    .unwrap()
+                    .distance();
+                assert!(
+                    (d - reference).abs() <= 1e-12 * reference,
+                    "{options:?} at ({x}, {y}): distance {d} against brute force {reference}"
+                );
+            }
+        }
+        context = pair.into_context();
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Degenerate volumes and models
 // ---------------------------------------------------------------------------------------
