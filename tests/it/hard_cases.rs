@@ -288,9 +288,9 @@ fn guard_case_without_the_guard_loses_real_contacts() {
 /// Two sticks (half-widths 1, 5e-4, 5e-4) nearly parallel, 0.004 rad apart, and B's pose
 /// a rotation scaled by 1 + 4.5e-7: orthonormal within 9e-7, which `Pose::new` accepts.
 /// The closest features are long edges, so the distance bound goes to the edge-edge axes,
-/// each almost the zero vector. An axis length of `√(1 − m_ij²)` cancels there: the
-/// scaled pose made it about half the true length, the bound of the sticks' boxes came out
-/// 16% above their distance, and the exact distance was 0.0409 instead of 0.0353.
+/// each almost the zero vector. An axis length of `√(1 − m_ij²)` cancels there and comes
+/// out short under the scaled pose, so the bound overshot: the exact distance at (−0.5,
+/// −0.04) was 0.0409 instead of 0.0353.
 #[test]
 fn nearly_parallel_sticks_under_a_pose_at_the_orthonormality_tolerance() {
     let stick = common::cuboid([1.0, 5e-4, 5e-4], [0.0; 3]);
