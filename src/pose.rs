@@ -6,6 +6,11 @@ use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuat
 /// Largest deviation of `RᵀR` from the identity accepted for a rotation.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-6;
 
+/// Largest deviation of `RᵀR` from the identity that [`Pose::new`] keeps as given: the
+/// rounding of a rotation computed in f64 (a few ulps), which the volume tests' rounding
+/// slack covers. Anything above it is projected onto the nearest rotation.
+const RIGID: f64 = 8.0 * f64::EPSILON;
+
 /// A rigid motion placing one frame in another: a point `p` of the placed frame is
 /// `rotation * p + translation` in the other. Always f64, whatever the stored precision of
 /// the trees.
@@ -15,11 +20,13 @@ pub const ORTHONORMAL_TOLERANCE: f64 = 1e-6;
 /// (translation in A's model units): queries compute it once and the volume tests of
 /// [`crate::bv`] take it, named `b_to_a` for what it maps.
 ///
-/// The rotation is orthonormal with determinant +1, within [`ORTHONORMAL_TOLERANCE`]:
-/// [`Pose::new`] and the constructors built on it check that, and that every number is
-/// finite; [`Pose::identity`] and [`Pose::translation`] have the identity rotation (the
-/// latter takes its numbers as given). A relative pose, composed of two such poses, is not
-/// checked again: its rotation is orthonormal within a few times the tolerance.
+/// The rotation is a rotation to f64 rounding: [`Pose::new`] and the constructors built on
+/// it refuse non-finite numbers, reflections and matrices farther than
+/// [`ORTHONORMAL_TOLERANCE`] from orthonormal, and replace one within it (a rotation read
+/// with few digits, or composed in f32) by the nearest rotation, so that every query
+/// answers for a rigid motion, as its volume tests assume. [`Pose::identity`] and
+/// [`Pose::translation`] have the identity rotation (the latter takes its numbers as given).
+/// A relative pose, composed of two such poses, is rigid to a few ulps more.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pose {
     rotation: Matrix3<f64>,
@@ -103,7 +110,8 @@ pub enum PoseFormat {
 /// A pose read from numbers, and how much it was repaired.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParsedPose {
-    /// The pose (exactly as given when no repair was asked for).
+    /// The pose: as given when no repair was asked for, but for the projection of
+    /// [`Pose::new`] (a change within [`ORTHONORMAL_TOLERANCE`]).
     pub pose: Pose,
     /// The repair made: the largest change of a rotation entry (nearest rotation), or the
     /// quaternion's distance from norm 1; 0 without repair.
@@ -295,6 +303,22 @@ fn nearest_rotation(m: &Matrix3<f64>) -> Result<(Matrix3<f64>, f64), PoseError> 
     Ok((nearest, correction))
 }
 
+/// The nearest rotation to `r`, a rotation with determinant +1 orthonormal within
+/// [`ORTHONORMAL_TOLERANCE`]: Newton–Schulz steps `r ← r (3I − rᵀr) / 2` converge to its
+/// polar factor, squaring the deviation each step, so two reach rounding from 1e-6; the
+/// loop stops at [`RIGID`] or after four.
+fn made_rigid(mut r: Matrix3<f64>) -> Matrix3<f64> {
+    let identity = Matrix3::identity();
+    for _ in 0..4 {
+        let gram = r.transpose() * r;
+        if (gram - identity).abs().max() <= RIGID {
+            break;
+        }
+        r = r * (identity * 3.0 - gram) * 0.5;
+    }
+    r
+}
+
 impl Default for Pose {
     fn default() -> Self {
         Pose::identity()
@@ -312,6 +336,11 @@ impl Pose {
 
     /// A pose from a rotation and a translation, refusing non-finite numbers, rotations not
     /// orthonormal within 1e-6, and reflections.
+    ///
+    /// A matrix orthonormal within the tolerance but beyond f64 rounding is replaced by
+    /// the nearest rotation (its polar factor; entries move by about the deviation):
+    /// the box and sphere tests take the rotation as rigid, and a stretch of 1e-6 would
+    /// let them miss contacts that deep. Rotations computed in f64 are kept bit for bit.
     ///
     /// # Errors
     ///
@@ -354,6 +383,11 @@ impl Pose {
         if determinant < 0.0 {
             return Err(PoseError::Reflection { determinant });
         }
+        let rotation = if deviation > RIGID {
+            made_rigid(rotation)
+        } else {
+            rotation
+        };
         Ok(Pose {
             rotation,
             translation,

@@ -155,3 +155,52 @@ fn what_no_repair_can_fix_is_refused() {
         .parse(&zero, true)
         .is_err());
 }
+
+/// The largest entry of `|RᵀR − I|`.
+fn deviation(r: &Matrix3<f64>) -> f64 {
+    (r.transpose() * r - Matrix3::identity()).abs().max()
+}
+
+/// A rotation within the tolerance of orthonormal but beyond rounding (scaled, stretched
+/// along a direction, sheared, or disturbed at random by up to 1e-6) becomes the nearest
+/// rotation, the same as the SVD's polar factor, rigid to rounding; a rotation computed in
+/// f64 is kept bit for bit.
+#[test]
+fn rotations_within_the_tolerance_are_made_rigid() {
+    let mut rng = obbtree::generate::Rng::new(5);
+    for k in 0..4000 {
+        let q = rng.uniform_rotation();
+        let kept = Pose::new(q, Vector3::zeros()).unwrap();
+        assert_eq!(*kept.rotation(), q, "case {k}: a computed rotation changed");
+        let e = match k % 4 {
+            0 => Matrix3::identity() * rng.signed(),
+            1 => {
+                let u = Vector3::new(rng.signed(), rng.signed(), rng.signed()).normalize();
+                u * u.transpose()
+            }
+            2 => {
+                let mut e = Matrix3::zeros();
+                e[(k / 4 % 3, (k / 12 + 1) % 3)] = rng.signed();
+                e
+            }
+            _ => Matrix3::from_fn(|_, _| rng.signed()),
+        };
+        let given = q * (Matrix3::identity() + e * (4.9e-7 * rng.unit()));
+        let Ok(pose) = Pose::new(given, Vector3::zeros()) else {
+            continue;
+        };
+        let r = pose.rotation();
+        assert!(
+            deviation(r) <= 8.0 * f64::EPSILON,
+            "case {k}: deviation {:e} from {:e}",
+            deviation(r),
+            deviation(&given)
+        );
+        let svd = given.svd(true, true);
+        let polar = svd.u.unwrap() * svd.v_t.unwrap();
+        assert!(
+            (r - polar).abs().max() < 1e-14,
+            "case {k}: {r} against the polar factor {polar}"
+        );
+    }
+}
