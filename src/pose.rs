@@ -303,6 +303,16 @@ fn nearest_rotation(m: &Matrix3<f64>) -> Result<(Matrix3<f64>, f64), PoseError> 
     Ok((nearest, correction))
 }
 
+/// The largest entry of `|rᵀr − I|`: the column products' departures from 1 and 0.
+#[inline]
+fn deviation(r: &Matrix3<f64>) -> f64 {
+    let (c0, c1, c2) = (r.column(0), r.column(1), r.column(2));
+    let square = |c: &nalgebra::VectorView3<f64>| (c.dot(c) - 1.0).abs();
+    let diagonal = square(&c0).max(square(&c1)).max(square(&c2));
+    let off = c0.dot(&c1).abs().max(c0.dot(&c2).abs()).max(c1.dot(&c2).abs());
+    diagonal.max(off)
+}
+
 /// The nearest rotation to `r`, a rotation with determinant +1 orthonormal within
 /// [`ORTHONORMAL_TOLERANCE`]: Newton–Schulz steps `r ← r (3I − rᵀr) / 2` converge to its
 /// polar factor, squaring the deviation each step, so two reach rounding from 1e-6; the
@@ -310,11 +320,10 @@ fn nearest_rotation(m: &Matrix3<f64>) -> Result<(Matrix3<f64>, f64), PoseError> 
 fn made_rigid(mut r: Matrix3<f64>) -> Matrix3<f64> {
     let identity = Matrix3::identity();
     for _ in 0..4 {
-        let gram = r.transpose() * r;
-        if (gram - identity).abs().max() <= RIGID {
+        if deviation(&r) <= RIGID {
             break;
         }
-        r = r * (identity * 3.0 - gram) * 0.5;
+        r = r * (identity * 3.0 - r.transpose() * r) * 0.5;
     }
     r
 }
@@ -367,19 +376,24 @@ impl Pose {
     /// # Ok::<(), PoseError>(())
     /// ```
     pub fn new(rotation: Matrix3<f64>, translation: Vector3<f64>) -> Result<Pose, PoseError> {
-        let row_major = rotation.transpose();
-        for (index, &value) in row_major.iter().chain(translation.iter()).enumerate() {
-            if !value.is_finite() {
-                return Err(PoseError::NotFinite { index, value });
+        // Every pose of a batch passes here: plain arithmetic on the columns (nalgebra's
+        // generic product, `abs` and `max` cost several times as much), and the error's
+        // index found only once something is not finite.
+        let all_finite = rotation.iter().chain(translation.iter()).all(|v| v.is_finite());
+        if !all_finite {
+            let row_major = rotation.transpose();
+            for (index, &value) in row_major.iter().chain(translation.iter()).enumerate() {
+                if !value.is_finite() {
+                    return Err(PoseError::NotFinite { index, value });
+                }
             }
         }
-        let deviation = (rotation.transpose() * rotation - Matrix3::identity())
-            .abs()
-            .max();
+        let deviation = deviation(&rotation);
         if deviation > ORTHONORMAL_TOLERANCE {
             return Err(PoseError::NotOrthonormal { deviation });
         }
-        let determinant = rotation.determinant();
+        let (c0, c1, c2) = (rotation.column(0), rotation.column(1), rotation.column(2));
+        let determinant = c0.dot(&c1.cross(&c2));
         if determinant < 0.0 {
             return Err(PoseError::Reflection { determinant });
         }
