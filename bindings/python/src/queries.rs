@@ -5,7 +5,7 @@
 //! comes back with plain vectors, which become NumPy arrays when first read.
 
 use crate::errors::{Failure, Kind};
-use crate::poses::RawPoses;
+use crate::poses::Poses;
 use crate::tree::Tree;
 use numpy::{PyArray1, PyArrayMethods};
 use obbtree::format::ObbtFile;
@@ -66,9 +66,8 @@ pub fn detached<T: Send>(
 pub struct Batch {
     a: Arc<ObbtFile>,
     b: Arc<ObbtFile>,
-    poses_a: RawPoses,
-    poses_b: RawPoses,
-    orthonormalize: bool,
+    poses_a: Vec<Pose>,
+    poses_b: Vec<Pose>,
     threads: Option<usize>,
 }
 
@@ -84,9 +83,8 @@ impl Batch {
         Ok(Batch {
             a: a.file()?,
             b: b.file()?,
-            poses_a: RawPoses::extract("poses_a", poses_a)?,
-            poses_b: RawPoses::extract("poses_b", poses_b)?,
-            orthonormalize,
+            poses_a: Poses::extract("poses_a", poses_a, orthonormalize)?.poses,
+            poses_b: Poses::extract("poses_b", poses_b, orthonormalize)?.poses,
             threads: threads_arg(threads)?,
         })
     }
@@ -105,9 +103,7 @@ impl Batch {
         T: Send,
         F: Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<T, QueryError> + Send + Sync,
     {
-        let pa = self.poses_a.parse(self.orthonormalize)?;
-        let pb = self.poses_b.parse(self.orthonormalize)?;
-        let poses = PoseBatch::new(&pa, &pb)?;
+        let poses = PoseBatch::new(&self.poses_a, &self.poses_b)?;
         let options = BatchOptions {
             threads: self.threads.and_then(NonZeroUsize::new),
         };
@@ -857,12 +853,10 @@ pub fn _time_rust_loop(
     repeat: usize,
 ) -> PyResult<f64> {
     let (fa, fb) = (a.file()?, b.file()?);
-    let ra = RawPoses::extract("poses_a", poses_a)?;
-    let rb = RawPoses::extract("poses_b", poses_b)?;
+    let pa = Poses::extract("poses_a", poses_a, false)?.poses;
+    let pb = Poses::extract("poses_b", poses_b, false)?.poses;
     let query = query.to_owned();
     let seconds = py.detach(move || -> Result<f64, Failure> {
-        let pa = ra.parse(false)?;
-        let pb = rb.parse(false)?;
         let n = pa.len().max(pb.len()).max(1);
         let mut pair = PairQuery::new(&fa, &fb)?;
         let first = CollideOptions {
