@@ -309,7 +309,11 @@ fn deviation(r: &Matrix3<f64>) -> f64 {
     let (c0, c1, c2) = (r.column(0), r.column(1), r.column(2));
     let square = |c: &nalgebra::VectorView3<f64>| (c.dot(c) - 1.0).abs();
     let diagonal = square(&c0).max(square(&c1)).max(square(&c2));
-    let off = c0.dot(&c1).abs().max(c0.dot(&c2).abs()).max(c1.dot(&c2).abs());
+    let off = c0
+        .dot(&c1)
+        .abs()
+        .max(c0.dot(&c2).abs())
+        .max(c1.dot(&c2).abs());
     diagonal.max(off)
 }
 
@@ -379,7 +383,10 @@ impl Pose {
         // Every pose of a batch passes here: plain arithmetic on the columns (nalgebra's
         // generic product, `abs` and `max` cost several times as much), and the error's
         // index found only once something is not finite.
-        let all_finite = rotation.iter().chain(translation.iter()).all(|v| v.is_finite());
+        let all_finite = rotation
+            .iter()
+            .chain(translation.iter())
+            .all(|v| v.is_finite());
         if !all_finite {
             let row_major = rotation.transpose();
             for (index, &value) in row_major.iter().chain(translation.iter()).enumerate() {
