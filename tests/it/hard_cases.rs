@@ -99,42 +99,19 @@ fn check_scene(name: &str, a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pos
         let pairs = oracle::contact_pairs(&ta, &tb);
         let reference = oracle::min_distance(&ta, &tb);
         let mut pair = PairQuery::with_context(&fa, &fb, std::mem::take(&mut context)).unwrap();
-
-        let all = pair
-            .collide(pose_a, pose_b, &CollideOptions::default())
-            .unwrap();
-        assert_eq!(all.pairs, pairs, "{what}: contacting pairs");
-        let first = CollideOptions {
-            first_contact: true,
-            ..CollideOptions::default()
-        };
-        let one = pair.collide(pose_a, pose_b, &first).unwrap();
-        assert_eq!(one.colliding, !pairs.is_empty(), "{what}: first contact");
-        let d = pair
-            .distance(pose_a, pose_b, &DistanceOptions::default())
-            .unwrap();
-        assert!(
-            (d.distance() - reference).abs() <= 1e-12 * reference.max(1e-300),
-            "{what}: distance {} against brute force {reference}",
-            d.distance()
-        );
+        let d = agrees_with_brute_force(&mut pair, pose_a, pose_b, &pairs, reference, &what);
         match expect {
             Expect::Contact => {
-                assert!(all.colliding, "{what}: contact expected");
-                assert_eq!(
-                    d.distance(),
-                    0.0,
-                    "{what}: touching surfaces are at distance 0"
-                );
+                assert!(!pairs.is_empty(), "{what}: contact expected");
+                assert_eq!(d, 0.0, "{what}: touching surfaces are at distance 0");
             }
             Expect::Gap(gap) => {
-                assert!(!all.colliding, "{what}: no contact expected");
+                assert!(pairs.is_empty(), "{what}: no contact expected");
                 let tolerance =
                     hand_tolerance(gap, options.precision, magnitude(&ta).max(magnitude(&tb)));
                 assert!(
-                    (d.distance() - gap).abs() <= tolerance,
-                    "{what}: distance {} against {gap} by hand",
-                    d.distance()
+                    (d - gap).abs() <= tolerance,
+                    "{what}: distance {d} against {gap} by hand"
                 );
                 // "Closer than t" agrees on both sides of the gap.
                 for (t, closer) in [(gap * 0.5, false), (gap * 2.0, true)] {
@@ -149,6 +126,38 @@ fn check_scene(name: &str, a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pos
         }
         context = pair.into_context();
     }
+}
+
+/// Checks collide (all pairs and first contact) and the exact distance of `pair` at the
+/// poses against brute force's contacting `pairs` and distance `reference`; returns the
+/// distance.
+fn agrees_with_brute_force(
+    pair: &mut PairQuery<'_>,
+    pose_a: &Pose,
+    pose_b: &Pose,
+    pairs: &[(u32, u32)],
+    reference: f64,
+    what: &str,
+) -> f64 {
+    let all = pair
+        .collide(pose_a, pose_b, &CollideOptions::default())
+        .unwrap();
+    assert_eq!(all.pairs, pairs, "{what}: contacting pairs");
+    let first = CollideOptions {
+        first_contact: true,
+        ..CollideOptions::default()
+    };
+    let one = pair.collide(pose_a, pose_b, &first).unwrap();
+    assert_eq!(one.colliding, !pairs.is_empty(), "{what}: first contact");
+    let d = pair
+        .distance(pose_a, pose_b, &DistanceOptions::default())
+        .unwrap()
+        .distance();
+    assert!(
+        (d - reference).abs() <= 1e-12 * reference.max(1e-300),
+        "{what}: distance {d} against brute force {reference}"
+    );
+    d
 }
 
 fn mesh(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> TriMesh {
@@ -335,24 +344,7 @@ fn sweep_against_brute_force(a: &TriMesh, b: &TriMesh, poses: &[(Pose, Pose)]) -
             let pairs = oracle::contact_pairs(&ta, &tb);
             let reference = oracle::min_distance(&ta, &tb);
             touching += usize::from(!pairs.is_empty());
-            let all = pair
-                .collide(pose_a, pose_b, &CollideOptions::default())
-                .unwrap();
-            assert_eq!(all.pairs, pairs, "{what}: contacting pairs");
-            let first = CollideOptions {
-                first_contact: true,
-                ..CollideOptions::default()
-            };
-            let one = pair.collide(pose_a, pose_b, &first).unwrap();
-            assert_eq!(one.colliding, !pairs.is_empty(), "{what}: first contact");
-            let d = pair
-                .distance(pose_a, pose_b, &DistanceOptions::default())
-                .unwrap()
-                .distance();
-            assert!(
-                (d - reference).abs() <= 1e-12 * reference,
-                "{what}: distance {d} against brute force {reference}"
-            );
+            agrees_with_brute_force(&mut pair, pose_a, pose_b, &pairs, reference, &what);
             let within = pair
                 .within(pose_a, pose_b, &ToleranceOptions::new(1e-6))
                 .unwrap();
