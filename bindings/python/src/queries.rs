@@ -1,6 +1,6 @@
 //! The pair queries over pose batches: `collide`, `distance`, `within`, `span`.
 //!
-//! Every query copies the poses out of Python, then releases the GIL: it checks them,
+//! Every query reads and checks the poses while it holds the GIL, then releases it: it
 //! makes one `PairQuery` per worker thread, answers every pose in parallel (rayon) and
 //! comes back with plain vectors, which become NumPy arrays when first read.
 
@@ -90,7 +90,8 @@ impl Batch {
     }
 
     /// Answers every pose pair with `query`, in pose order; runs with the GIL released.
-    fn run<T, F>(self, py: Python<'_>, query: F) -> PyResult<Vec<T>>
+    /// The first error of any pose is the error of the whole batch.
+    fn run<T, F>(self, py: Python<'_>, query: F) -> PyResult<Answers<T>>
     where
         T: Send,
         F: Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<T, QueryError> + Send + Sync,
@@ -98,7 +99,7 @@ impl Batch {
         Ok(py.detach(move || self.run_detached(query))?)
     }
 
-    fn run_detached<T, F>(self, query: F) -> Result<Vec<T>, Failure>
+    fn run_detached<T, F>(self, query: F) -> Result<Answers<T>, Failure>
     where
         T: Send,
         F: Fn(&mut PairQuery<'_>, &Pose, &Pose) -> Result<T, QueryError> + Send + Sync,
@@ -107,10 +108,42 @@ impl Batch {
         let options = BatchOptions {
             threads: self.threads.and_then(NonZeroUsize::new),
         };
-        batch(&self.a, &self.b, poses, &options, query)?
-            .into_iter()
-            .map(|answer| answer.map_err(Failure::from))
-            .collect()
+        let mut answers = batch(&self.a, &self.b, poses, &options, query)?;
+        if let Some(first) = answers.iter().position(Result::is_err) {
+            if let Err(e) = answers.swap_remove(first) {
+                return Err(e.into());
+            }
+        }
+        Ok(Answers(answers))
+    }
+}
+
+/// The answers of a batch that has no error, left in the vector the library returned
+/// them in: moving them into a vector of their own cost as much again as a batch of
+/// poses culled at their roots.
+pub struct Answers<T>(Vec<Result<T, QueryError>>);
+
+impl<T> Answers<T> {
+    /// The answers, in pose order.
+    fn iter(&self) -> impl Iterator<Item = &T> {
+        self.0.iter().filter_map(|a| a.as_ref().ok())
+    }
+
+    /// How many.
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+}
+
+impl<T> IntoIterator for Answers<T> {
+    type Item = T;
+    type IntoIter = std::iter::FilterMap<
+        std::vec::IntoIter<Result<T, QueryError>>,
+        fn(Result<T, QueryError>) -> Option<T>,
+    >;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.into_iter().filter_map(Result::ok)
     }
 }
 
@@ -301,10 +334,13 @@ struct Witnesses {
 }
 
 impl Witnesses {
-    /// Columns of `answers`: (witness or None, work). None gives `missing` as the distance,
-    /// NaN points and triangle -1.
-    fn new(answers: Vec<(Option<Witness>, Work)>, missing: f64) -> Witnesses {
-        let n = answers.len();
+    /// Columns of the `n` answers of `answers`: (witness or None, work). None gives
+    /// `missing` as the distance, NaN points and triangle -1.
+    fn new(
+        answers: impl Iterator<Item = (Option<Witness>, Work)>,
+        n: usize,
+        missing: f64,
+    ) -> Witnesses {
         let mut w = Witnesses {
             distance: Vec::with_capacity(n),
             point_a: Vec::with_capacity(3 * n),
@@ -622,8 +658,13 @@ pub fn collide(
         ..CollideOptions::default()
     };
     let batch = Batch::new(&a, poses_a, &b, poses_b, orthonormalize, threads)?;
+    // Each pose's answer is its count and work, and only where asked for its pairs and
+    // geometry, boxed: the answers of a large batch are written by every worker at once,
+    // and their size (their pages' first touches) decides what such a batch costs when
+    // its poses are cheap.
     let answers = batch.run(py, |pair, pa, pb| {
         let r = pair.collide(pa, pb, &options)?;
+        let count = i64::try_from(r.pairs.len()).unwrap_or(i64::MAX);
         let shapes = geometry.then(|| {
             let points = r
                 .contacts
@@ -632,18 +673,20 @@ pub fn collide(
                 .collect();
             (points, r.curve_length(), r.overlap_area())
         });
-        Ok((r.pairs, shapes, r.work))
+        let kept = (pairs || geometry).then(|| Box::new((r.pairs, shapes)));
+        Ok((count, kept, r.work))
     })?;
-    let contacts = answers
-        .iter()
-        .map(|(p, _, _)| i64::try_from(p.len()).unwrap_or(i64::MAX))
-        .collect();
+    let contacts = answers.iter().map(|(count, _, _)| *count).collect();
     let work = answers.iter().map(|(_, _, w)| *w).collect();
-    let mut shapes = Vec::with_capacity(answers.len());
-    let mut pair_lists = Vec::with_capacity(answers.len());
-    for (p, g, _) in answers {
-        pair_lists.push(p);
-        shapes.extend(g);
+    let (mut shapes, mut pair_lists) = (Vec::new(), Vec::new());
+    for (_, kept, _) in answers {
+        if let Some(kept) = kept {
+            let (p, g) = *kept;
+            if pairs {
+                pair_lists.push(p);
+            }
+            shapes.extend(g);
+        }
     }
     Ok(CollideResult {
         contacts,
@@ -697,8 +740,9 @@ pub fn distance(
         let r = pair.distance(pa, pb, &options)?;
         Ok((r.closest, r.work))
     })?;
+    let n = answers.len();
     Ok(DistanceResult {
-        columns: Witnesses::new(answers, f64::INFINITY),
+        columns: Witnesses::new(answers.into_iter(), n, f64::INFINITY),
         arrays: WitnessArrays::default(),
     })
 }
@@ -732,9 +776,10 @@ pub fn within(
         let r = pair.within(pa, pb, &options)?;
         Ok((r.witness, r.work))
     })?;
+    let n = answers.len();
     let closer = answers.iter().map(|(w, _)| w.is_some()).collect();
     Ok(WithinResult {
-        columns: Witnesses::new(answers, f64::NAN),
+        columns: Witnesses::new(answers.into_iter(), n, f64::NAN),
         arrays: WitnessArrays::default(),
         closer,
         closer_array: PyOnceLock::new(),
@@ -766,8 +811,9 @@ pub fn span(
         let r = pair.span(pa, pb, &options)?;
         Ok((Some(r.farthest), r.work))
     })?;
+    let n = answers.len();
     Ok(SpanResult {
-        columns: Witnesses::new(answers, f64::NAN),
+        columns: Witnesses::new(answers.into_iter(), n, f64::NAN),
         arrays: WitnessArrays::default(),
     })
 }
@@ -811,26 +857,24 @@ pub fn hausdorff(
     let answers = batch.run(py, |_, pa, pb| {
         obbtree::query::hausdorff(&fa, pa, &fb, pb, &options)
     })?;
+    let n = answers.len();
     let upper_bound = answers.iter().map(|h| h.upper_bound).collect();
     let b_to_a = answers
         .iter()
         .map(|h| h.direction == HausdorffDirection::BToA)
         .collect();
-    let witnesses = answers
-        .into_iter()
-        .map(|h| {
-            let w = Witness {
-                distance: h.distance,
-                point_a: h.point_a.into(),
-                point_b: h.point_b.into(),
-                tri_a: h.tri_a,
-                tri_b: h.tri_b,
-            };
-            (Some(w), h.work)
-        })
-        .collect();
+    let witnesses = answers.into_iter().map(|h| {
+        let w = Witness {
+            distance: h.distance,
+            point_a: h.point_a.into(),
+            point_b: h.point_b.into(),
+            tri_a: h.tri_a,
+            tri_b: h.tri_b,
+        };
+        (Some(w), h.work)
+    });
     Ok(HausdorffResult {
-        columns: Witnesses::new(witnesses, f64::NAN),
+        columns: Witnesses::new(witnesses, n, f64::NAN),
         arrays: WitnessArrays::default(),
         upper_bound,
         upper_bound_array: PyOnceLock::new(),
