@@ -55,10 +55,11 @@ fn with_numbers<T>(
     read: impl FnOnce(&[usize], &[f64]) -> PyResult<T>,
 ) -> PyResult<T> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
-        // SAFETY: the array is read while this thread holds the GIL (no Python code runs),
-        // and only within this call; this extension never makes a writable view of an
-        // array it is given, so nothing else writes to it meanwhile. (This skips
-        // rust-numpy's borrow tracking, which costs more than the read for one pose.)
+        // SAFETY: the array is read while this thread holds the GIL, only within this
+        // call, and `read` runs no Python code (callers keep it so); this extension never
+        // makes a writable view of an array it is given, so nothing else writes to it
+        // meanwhile. (This skips rust-numpy's borrow tracking, which costs more than the
+        // read for one pose.)
         let view = unsafe { a.as_array() };
         if let Some(values) = view.as_slice() {
             return read(view.shape(), values);
@@ -119,31 +120,35 @@ impl Poses {
         t: &Bound<'_, PyAny>,
         orthonormalize: bool,
     ) -> PyResult<Poses> {
-        with_numbers(name, r, |r_shape, r| {
-            with_numbers(name, t, |t_shape, t| {
-                let (count, single) = match (r_shape, t_shape) {
-                    ([3, 3], [3]) => (1, true),
-                    ([n, 3, 3], [m, 3]) if n == m => (*n, false),
-                    (rs, ts) => {
-                        return Err(bad(
-                            name,
-                            format!(
-                                "an (R, t) pair needs R (3, 3) and t (3,), or R (N, 3, 3) and t (N, 3); got R {} and t {}",
-                                shape_text(rs),
-                                shape_text(ts)
-                            ),
-                        ))
-                    }
-                };
-                let mut values = Vec::with_capacity(12 * count);
-                for (rotation, translation) in r.chunks_exact(9).zip(t.chunks_exact(3)) {
-                    values.extend_from_slice(rotation);
-                    values.extend_from_slice(translation);
+        // R's numbers are copied before t is read: reading t may run Python code (its
+        // conversion to an array), which must not happen while R's memory is borrowed.
+        let (r_shape, r) = with_numbers(name, r, |shape, values| {
+            Ok((shape.to_vec(), values.to_vec()))
+        })?;
+        let (r_shape, r) = (r_shape.as_slice(), r.as_slice());
+        with_numbers(name, t, |t_shape, t| {
+            let (count, single) = match (r_shape, t_shape) {
+                ([3, 3], [3]) => (1, true),
+                ([n, 3, 3], [m, 3]) if n == m => (*n, false),
+                (rs, ts) => {
+                    return Err(bad(
+                        name,
+                        format!(
+                            "an (R, t) pair needs R (3, 3) and t (3,), or R (N, 3, 3) and t (N, 3); got R {} and t {}",
+                            shape_text(rs),
+                            shape_text(ts)
+                        ),
+                    ))
                 }
-                let format = PoseFormat::RotationTranslation;
-                let poses = parse(name, single, format, &values, orthonormalize)?;
-                Ok(Poses { poses, single })
-            })
+            };
+            let mut values = Vec::with_capacity(12 * count);
+            for (rotation, translation) in r.chunks_exact(9).zip(t.chunks_exact(3)) {
+                values.extend_from_slice(rotation);
+                values.extend_from_slice(translation);
+            }
+            let format = PoseFormat::RotationTranslation;
+            let poses = parse(name, single, format, &values, orthonormalize)?;
+            Ok(Poses { poses, single })
         })
     }
 }

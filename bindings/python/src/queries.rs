@@ -80,12 +80,13 @@ impl Batch {
         orthonormalize: bool,
         threads: Option<i64>,
     ) -> PyResult<Batch> {
+        let (a, b, threads) = (a.file()?, b.file()?, threads_arg(threads)?);
         Ok(Batch {
-            a: a.file()?,
-            b: b.file()?,
+            a,
+            b,
             poses_a: Poses::extract("poses_a", poses_a, orthonormalize)?.poses,
             poses_b: Poses::extract("poses_b", poses_b, orthonormalize)?.poses,
-            threads: threads_arg(threads)?,
+            threads,
         })
     }
 
@@ -114,13 +115,15 @@ impl Batch {
                 return Err(e.into());
             }
         }
+        debug_assert!(answers.iter().all(Result::is_ok));
         Ok(Answers(answers))
     }
 }
 
 /// The answers of a batch that has no error, left in the vector the library returned
 /// them in: moving them into a vector of their own cost as much again as a batch of
-/// poses culled at their roots.
+/// poses culled at their roots. Made only by [`Batch::run`], after it checked that no
+/// pose failed, so that skipping errors while iterating skips none.
 pub struct Answers<T>(Vec<Result<T, QueryError>>);
 
 impl<T> Answers<T> {
@@ -673,7 +676,8 @@ pub fn collide(
                 .collect();
             (points, r.curve_length(), r.overlap_area())
         });
-        let kept = (pairs || geometry).then(|| Box::new((r.pairs, shapes)));
+        let list = if pairs { r.pairs } else { Vec::new() };
+        let kept = (pairs || geometry).then(|| Box::new((list, shapes)));
         Ok((count, kept, r.work))
     })?;
     let contacts = answers.iter().map(|(count, _, _)| *count).collect();

@@ -58,6 +58,22 @@ def test_pose_forms_agree(cow, poses):
         assert obbtree.distance(cow, a[i], cow, one).distance[0] == ref[i]
 
 
+def test_an_r_t_pair_reads_r_before_t_runs_python_code(cow):
+    # Converting t may run Python code; R's numbers must be read before it, not borrowed
+    # across it (a t that changes R on conversion once made the binding read the new R).
+    r = np.eye(3)
+
+    class Translation:
+        def __array__(self, dtype=None, copy=None):
+            r[0, 0] = 12.0
+            return np.array([3.0, 0.0, 0.0])
+
+    as_given = np.eye(4)
+    as_given[0, 3] = 3.0
+    exact = obbtree.distance(cow, np.eye(4), cow, as_given).distance
+    assert np.array_equal(obbtree.distance(cow, np.eye(4), cow, (r, Translation())).distance, exact)
+
+
 def test_float32_and_int_poses_are_converted(cow):
     p = np.eye(4, dtype=np.float32)
     p[0, 3] = 3
