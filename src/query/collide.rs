@@ -242,8 +242,10 @@ pub fn collide_into<B: BoundingVolume>(
 #[inline]
 fn balls_apart((ca, ra): ([f64; 3], f64), (cb, rb): ([f64; 3], f64), b_to_a: &Pose) -> bool {
     let (ca, cb) = (Vector3::from(ca), b_to_a.apply(&Vector3::from(cb)));
-    // Mapping B's centre and the difference round by a few ulps of their magnitudes; a
-    // rotation rigid to rounding (`Pose::new`) stretches B's ball by a few ulps of its radius.
-    let rounding = OFFSET_ROUNDING * (ca.abs().sum() + cb.abs().sum() + rb);
+    // Mapping B's centre and the difference round by a few ulps of their magnitudes. A
+    // rotation rigid to rounding (`Pose::new`) stretches B's ball by a few ulps of its
+    // radius, which this covers too: where it can say apart, the centres are more than
+    // `rb` apart, so their magnitudes sum to more than `rb`.
+    let rounding = OFFSET_ROUNDING * (ca.abs().sum() + cb.abs().sum());
     (cb - ca).norm() > ra + rb + rounding
 }
