@@ -353,7 +353,9 @@ impl Pose {
     /// A matrix orthonormal within the tolerance but beyond f64 rounding is replaced by
     /// the nearest rotation (its polar factor; entries move by about the deviation):
     /// the box and sphere tests take the rotation as rigid, and a stretch of 1e-6 would
-    /// let them miss contacts that deep. Rotations computed in f64 are kept bit for bit.
+    /// let them miss contacts that deep. A rotation within 8 ulps of orthonormal, as one
+    /// computed in f64 from a quaternion or angles is, is kept bit for bit (a product of
+    /// many rotations may be projected, by a few ulps).
     ///
     /// # Errors
     ///

@@ -164,7 +164,7 @@ fn deviation(r: &Matrix3<f64>) -> f64 {
 /// A rotation within the tolerance of orthonormal but beyond rounding (scaled, stretched
 /// along a direction, sheared, or disturbed at random by up to 1e-6) becomes the nearest
 /// rotation, the same as the SVD's polar factor, rigid to rounding; a rotation computed in
-/// f64 is kept bit for bit.
+/// f64 (here from a quaternion) is kept bit for bit.
 #[test]
 fn rotations_within_the_tolerance_are_made_rigid() {
     let mut rng = obbtree::generate::Rng::new(5);

@@ -671,7 +671,8 @@ enum ObbtreeStatus obbtree_info(const struct ObbtreeTree *tree, struct ObbtreeIn
 
 /**
  * Checks that the 12 numbers at `pose` are a rigid motion as every query requires:
- * `OBBTREE_STATUS_OK`, or `OBBTREE_STATUS_POSE` saying what is wrong.
+ * `OBBTREE_STATUS_OK`, or `OBBTREE_STATUS_POSE` saying what is wrong. (A rotation within
+ * the tolerance passes, and queries use its nearest rotation.)
  *
  * # Safety
  *

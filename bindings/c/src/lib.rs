@@ -17,7 +17,8 @@
 //!   refused with an error code before anything is read or written;
 //! - a pose is 12 `double`s: the rotation row by row, then the translation
 //!   (`world = R p + t`); it must be rigid (orthonormal within 1e-6, determinant +1, every
-//!   number finite), as the CLI requires.
+//!   number finite), as the CLI requires, and a rotation within the tolerance is used as
+//!   its nearest rotation.
 //!
 //! Threads: an `ObbtreeTree` may be used by any number of threads at once. An
 //! `ObbtreePair` is used by one thread at a time (it holds the traversal scratch); a
@@ -832,7 +833,8 @@ pub unsafe extern "C" fn obbtree_info(
 // ---------------------------------------------------------------------------------------
 
 /// Checks that the 12 numbers at `pose` are a rigid motion as every query requires:
-/// `OBBTREE_STATUS_OK`, or `OBBTREE_STATUS_POSE` saying what is wrong.
+/// `OBBTREE_STATUS_OK`, or `OBBTREE_STATUS_POSE` saying what is wrong. (A rotation within
+/// the tolerance passes, and queries use its nearest rotation.)
 ///
 /// # Safety
 ///

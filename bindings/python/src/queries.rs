@@ -632,7 +632,7 @@ witness_getters!(HausdorffResult, "of the witness pair", {
 /// meets (`geometry`, `curve_length`, `overlap_area`). threads: None for every core, or
 /// the number of threads for a batch. orthonormalize: replace each rotation by the nearest
 /// rotation (as the CLI's --orthonormalize; changes above 1e-2 are refused); without it a
-/// rotation must be orthonormal within 1e-6. rule: which tree to descend first (diameter,
+/// rotation must be orthonormal within 1e-6, and is used as its nearest rotation. rule: which tree to descend first (diameter,
 /// volume, area, a, b).
 ///
 /// Returns a `CollideResult` (contacts, colliding, pairs, work). The batch runs in parallel
