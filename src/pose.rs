@@ -22,8 +22,8 @@ const RIGID: f64 = 8.0 * f64::EPSILON;
 ///
 /// The rotation is a rotation to f64 rounding: [`Pose::new`] and the constructors built on
 /// it refuse non-finite numbers, reflections and matrices farther than
-/// [`ORTHONORMAL_TOLERANCE`] from orthonormal, and replace one within it (a rotation read
-/// with few digits, or composed in f32) by the nearest rotation, so that every query
+/// [`ORTHONORMAL_TOLERANCE`] from orthonormal, and replace one within it (a rotation
+/// printed with 7 digits, or computed in f32) by the nearest rotation, so that every query
 /// answers for a rigid motion, as its volume tests assume. [`Pose::identity`] and
 /// [`Pose::translation`] have the identity rotation (the latter takes its numbers as given).
 /// A relative pose, composed of two such poses, is rigid to a few ulps more.
