@@ -318,16 +318,16 @@ fn deviation(r: &Matrix3<f64>) -> f64 {
 }
 
 /// The nearest rotation to `r`, a rotation with determinant +1 orthonormal within
-/// [`ORTHONORMAL_TOLERANCE`]: Newton–Schulz steps `r ← r (3I − rᵀr) / 2` converge to its
-/// polar factor, squaring the deviation each step, so two reach rounding from 1e-6; the
-/// loop stops at [`RIGID`] or after four.
+/// [`ORTHONORMAL_TOLERANCE`] but not within [`RIGID`]: Newton–Schulz steps
+/// `r ← r (3I − rᵀr) / 2` converge to its polar factor, squaring the deviation each step,
+/// so two reach rounding from 1e-6; the loop stops at [`RIGID`] or after four.
 fn made_rigid(mut r: Matrix3<f64>) -> Matrix3<f64> {
     let identity = Matrix3::identity();
     for _ in 0..4 {
+        r = r * (identity * 3.0 - r.transpose() * r) * 0.5;
         if deviation(&r) <= RIGID {
             break;
         }
-        r = r * (identity * 3.0 - r.transpose() * r) * 0.5;
     }
     r
 }

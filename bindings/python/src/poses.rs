@@ -48,7 +48,8 @@ fn array<'py>(
 }
 
 /// Calls `read` with the shape and the numbers (row-major) of an array argument: the
-/// array's own memory where it is a contiguous float64 array, else a row-major copy.
+/// array's own memory where it is a contiguous float64 array, else a row-major copy of
+/// what NumPy makes of it.
 fn with_numbers<T>(
     name: &str,
     obj: &Bound<'_, PyAny>,
@@ -64,8 +65,6 @@ fn with_numbers<T>(
         if let Some(values) = view.as_slice() {
             return read(view.shape(), values);
         }
-        let values: Vec<f64> = view.iter().copied().collect();
-        return read(view.shape(), &values);
     }
     let a = array(name, obj)?;
     let view = a.as_array();
