@@ -89,7 +89,7 @@ pub struct TreeArgs {
     /// With --fit hull, the most vertices (at least 4) a node's hull is computed over:
     /// larger nodes take it over an evenly spaced sample of this many and the 6 that reach
     /// their bounding box; box extents still cover every vertex. `all` takes every hull
-    /// over every vertex [default: 2048].
+    /// over every vertex [default: 512].
     #[arg(long, value_name = "N|all", value_parser = parse_hull_points)]
     pub hull_max_points: Option<u32>,
     /// Also fit each node's box to the model's own axes, and keep that box wherever it is

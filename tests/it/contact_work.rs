@@ -40,6 +40,7 @@ fn first_contact_work_on_the_cow_is_pinned() {
     // With the children of each step in stored order (before the nearer was taken first):
     // 5,451 node pairs; nearer first, before boxes on the model's axes replaced fitted ones
     // where smaller: 2,063. Before nodes were split along the axis of least child volume
-    // (greatest spread only): 2,649.
-    assert_eq!(nodes, 2_563, "node pairs visited");
+    // (greatest spread only): 2,649. With hulls over samples of 2,048 vertices rather
+    // than 512: 2,563.
+    assert_eq!(nodes, 2_608, "node pairs visited");
 }

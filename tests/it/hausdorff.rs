@@ -439,9 +439,9 @@ fn work_is_pinned() {
         ("sphere/cow", &sphere, id, &cow, 0.0),
     ];
     let pinned: [(&str, [u64; 4]); 4] = [
-        ("cow/turned cow", [16372, 10711, 7150, 27364]),
-        ("cow/turned cow rel_err 0.01", [13219, 8861, 6058, 22285]),
-        ("cow/far sphere", [4006, 5071, 4120, 9221]),
+        ("cow/turned cow", [15982, 10484, 7057, 26741]),
+        ("cow/turned cow rel_err 0.01", [12924, 8692, 5977, 21815]),
+        ("cow/far sphere", [4031, 5104, 4146, 9281]),
         ("sphere/cow", [15616, 15010, 13374, 30801]),
     ];
     let measured: Vec<(&str, [u64; 4])> = cases
