@@ -132,10 +132,10 @@ pub const DEFAULT_HULL_MIN_FACES: u32 = 512;
 /// The default [`BuildOptions::hull_max_points`]. The top levels of a tree hold most of the
 /// remaining hull work, all the more on convex shapes, whose every vertex is a hull vertex;
 /// the hull of an evenly spaced sample of a dense surface has nearly the same covariance.
-/// Against larger samples and the hull over every vertex (`examples/tree_work`), this one
-/// built faster on every benchmark mesh and left the box tests and node pairs of
-/// collision and distance queries within a few percent, either way (the figures are in
-/// docs/results).
+/// Against larger samples, this one took fewer build instructions on each benchmark mesh
+/// measured (`examples/profile_build`) and left the box tests and node pairs of collision
+/// and distance queries within a few percent either way (`examples/tree_work`); the
+/// figures are in docs/results.
 pub const DEFAULT_HULL_MAX_POINTS: u32 = 512;
 
 /// The least [`BuildOptions::hull_max_points`]: a solid hull needs four points.
