@@ -4,7 +4,7 @@ use crate::errors::{Failure, Kind};
 use crate::poses::single_pose;
 use crate::queries::detached;
 use crate::tree::Tree;
-use crate::winding::point_rows;
+use crate::winding::{point_rows, row_of_three};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use obbtree::query::{all_ray_hits, cast_rays, QueryError, Ray, RayHit, RayMode, RayOptions};
 use pyo3::prelude::*;
@@ -138,11 +138,21 @@ fn ray_rows(
             ),
         ));
     }
-    let (o, d) = (point_rows(origins)?, point_rows(directions)?);
-    Ok(o.into_iter()
-        .zip(d)
-        .map(|(origin, direction)| Ray { origin, direction })
-        .collect())
+    let ray = |(origin, direction)| Ray { origin, direction };
+    Ok(match (o.as_slice(), d.as_slice()) {
+        // C-contiguous (as the Python side passes them): one pass over both flat slices.
+        (Some(o), Some(d)) => o
+            .chunks_exact(3)
+            .map(row_of_three)
+            .zip(d.chunks_exact(3).map(row_of_three))
+            .map(ray)
+            .collect(),
+        _ => point_rows(origins)?
+            .into_iter()
+            .zip(point_rows(directions)?)
+            .map(ray)
+            .collect(),
+    })
 }
 
 /// Hits as flat columns: `t`, `tri`, and the rows of `point`, `barycentric` and `normal`

@@ -20,16 +20,20 @@ pub fn point_rows(points: &PyReadonlyArray2<'_, f64>) -> Result<Vec<[f64; 3]>, F
     Ok(match view.as_slice() {
         // C-contiguous (as the Python side passes them): read as a flat slice, without
         // the views' per-element index arithmetic.
-        Some(flat) => flat
-            .chunks_exact(3)
-            .filter_map(|row| <[f64; 3]>::try_from(row).ok())
-            .collect(),
+        Some(flat) => flat.chunks_exact(3).map(row_of_three).collect(),
         None => view
             .rows()
             .into_iter()
             .map(|r| [r[0], r[1], r[2]])
             .collect(),
     })
+}
+
+/// A row of `chunks_exact(3)` as an array. (A `map`, unlike a `filter_map` of `try_from`,
+/// keeps the iterator's exact length, so that collecting allocates once.)
+#[inline(always)]
+pub fn row_of_three(row: &[f64]) -> [f64; 3] {
+    std::array::from_fn(|k| row.get(k).copied().unwrap_or(f64::NAN))
 }
 
 /// The options of `beta` and `tolerance` as `obbtree.winding_number` documents them:
