@@ -4,7 +4,8 @@
 //! random rays (incoherent). Prints the median
 //! time per closest-hit ray, the hit fraction and the mean work; trees are f64 unless
 //! `OBBTREE_PRECISION=f32`, in the fast layout unless `OBBTREE_LAYOUT=compact` (f32), of
-//! oriented boxes unless `OBBTREE_BV=aabb` or `sphere`.
+//! oriented boxes unless `OBBTREE_BV=aabb` or `sphere`. `OBBTREE_T_MAX` sets the rays'
+//! `t_max` (a tiny one, such as 1e-100, measures what a ray costs before its descent).
 // A tool developers run by hand: stopping loudly on a broken input is what it should do.
 #![allow(clippy::expect_used, clippy::indexing_slicing)]
 
@@ -51,6 +52,13 @@ fn main() {
         "first query (makes the ray index): {:.1} ms",
         started.elapsed().as_secs_f64() * 1e3
     );
+    let options = RayOptions {
+        t_max: std::env::var("OBBTREE_T_MAX")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(f64::INFINITY),
+        ..RayOptions::default()
+    };
     let camera = rays::camera_rays(&mesh, count);
     let random = rays::random_rays(&mesh, count, 7);
     for (name, rays) in [("camera", &camera), ("random", &random)] {
@@ -58,8 +66,7 @@ fn main() {
         let mut last = Vec::new();
         for _ in 0..runs {
             let started = Instant::now();
-            last =
-                cast_rays(&file, &Pose::identity(), rays, &RayOptions::default()).expect("answers");
+            last = cast_rays(&file, &Pose::identity(), rays, &options).expect("answers");
             times.push(started.elapsed().as_secs_f64());
         }
         times.sort_by(f64::total_cmp);
