@@ -6,19 +6,24 @@ use crate::query::quad::Quad;
 /// A ray in the model frame, set up for slab tests.
 pub(in crate::query) struct Slabs {
     origin: [f64; 3],
+    /// Per axis, `1 / d` (see [`Slabs::new`]): exits are computed with it.
     inverse: [f64; 3],
+    /// Per axis, `(1 / d) · SHRINK`, rounded: entries are computed with it, so that they
+    /// come out widened by their rounding with no step of their own (see [`SHRINK`]).
+    shrunk: [f64; 3],
     /// Per axis, whether the ray runs toward smaller coordinates: it then meets a box's
     /// `hi` plane first. Chosen once per ray, so a node's lanes need no comparison.
     negative: [bool; 3],
 }
 
-/// How much a computed slab parameter may be off, relative to itself: the difference,
-/// the inverse and the product each round once.
+/// How much a computed slab parameter may be off, relative to itself: it rounds at most
+/// four times (the difference, the inverse, the inverse's [`SHRINK`] for an entry, the
+/// product), each by at most `ε/2`.
 const SLAB_ROUNDING: f64 = 4.0 * f64::EPSILON;
 
 /// The factor that widens a computed entry (never negative) by the rounding of both it
-/// and the exit it is compared with, in one multiplication: an exact entry `x` at most an
-/// exact exit `y` gives `fl(x̃ (1 − 4r)) ≤ x (1 + r)(1 − 4r)(1 + ε/2) ≤ y (1 − r) ≤ ỹ`.
+/// and the exit it is compared with, taken into the entry's inverse once per ray: an exact
+/// entry `x` at most an exact exit `y` gives `x̃ ≤ x (1 − 4r)(1 + r) ≤ y (1 − r) ≤ ỹ`.
 /// (Exits have no widening of their own: their sign is exact, and only entries at least 0
 /// are compared with them.)
 const SHRINK: f64 = 1.0 - 4.0 * SLAB_ROUNDING;
@@ -39,6 +44,7 @@ impl Slabs {
         Slabs {
             origin,
             inverse,
+            shrunk: inverse.map(|i| i * SHRINK),
             negative: inverse.map(|i| i < 0.0),
         }
     }
@@ -53,28 +59,34 @@ impl Slabs {
     /// exit (a miss) and one on its near side prunes nothing; a plane through the origin
     /// gives NaN, which `max` and `min` pass over (on the boundary counts as inside), as
     /// they pass over every value of an axis whose inverse is NaN.
+    ///
+    /// The three axes are combined as a tree, y with z, then with x and the bounds (0 and
+    /// `reach`), not one after another: the node step is a chain of dependent operations
+    /// that a descent waits on, and this takes one of them off it. A NaN of z then passes
+    /// over y's value too, which only prunes less.
     // Axes count to 3, the length of every array they index.
     #[allow(clippy::indexing_slicing)]
     #[inline(always)]
     fn entries(&self, node: &IndexNode, reach: f64) -> ([f64; WIDTH], u32) {
-        let mut near = Quad::splat(0.0);
-        let mut far = Quad::splat(reach.min(FARTHEST));
-        for axis in 0..3 {
-            let (o, inverse) = (
-                Quad::splat(self.origin[axis]),
-                Quad::splat(self.inverse[axis]),
-            );
-            let (first, last) = if self.negative[axis] {
+        // The plane the ray meets first on `axis`, then the one it meets last.
+        let planes = |axis: usize| {
+            if self.negative[axis] {
                 (&node.hi[axis], &node.lo[axis])
             } else {
                 (&node.lo[axis], &node.hi[axis])
-            };
-            near = ((Quad::widen(first) - o) * inverse).max(near);
-            far = ((Quad::widen(last) - o) * inverse).min(far);
-        }
-        // Widened once: `x (1 − 4r)` is increasing in `x`, so this is the largest of the
-        // widened entries of the three slabs.
-        let near = near * Quad::splat(SHRINK);
+            }
+        };
+        let parameters = |plane: &[f32; WIDTH], axis: usize, inverse: f64| {
+            (Quad::widen(plane) - Quad::splat(self.origin[axis])) * Quad::splat(inverse)
+        };
+        let entry = |axis: usize| parameters(planes(axis).0, axis, self.shrunk[axis]);
+        let exit = |axis: usize| parameters(planes(axis).1, axis, self.inverse[axis]);
+        // `a.max(b)` passes over a NaN `a` but gives a NaN `b`: y with z is NaN only where
+        // z is, and the last step passes over that, its right operand holding a bound.
+        let near = entry(1).max(entry(2)).max(entry(0).max(Quad::splat(0.0)));
+        let far = exit(1)
+            .min(exit(2))
+            .min(exit(0).min(Quad::splat(reach.min(FARTHEST))));
         (near.to_array(), near.le_mask(far))
     }
 
